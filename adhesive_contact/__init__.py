@@ -1,0 +1,15 @@
+"""adhesive_contact: quasistatic adhesive contact of a viscoelastic body with
+long memory, solved with the fully discrete scheme of Cheng & Xiao
+(P1 displacements, P0 bonding on Γ_C, right rectangle memory, explicit
+Euler bonding) on scikit-fem. See MODEL.md for the mathematics."""
+
+from .expressions import ExpressionError, compile_expression
+from .problem import Problem, build_problem
+from .scene import Scene, SceneError, parse_scene, scene_from_dict
+from .timestepping import Solution, StepFailure, solve
+
+__version__ = "0.1.0"
+
+__all__ = ["ExpressionError", "compile_expression", "Problem", "build_problem", "Scene",
+           "SceneError", "parse_scene", "scene_from_dict", "Solution", "StepFailure",
+           "solve", "__version__"]

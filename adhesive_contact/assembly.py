@@ -1,0 +1,148 @@
+"""Everything assembled once per mesh: stiffness parts, load and strain maps.
+
+An isotropic tensor C ε = λ tr(ε) I + 2 μ ε has the stiffness
+λ K_λ + μ K_μ with
+
+    K_λ = ∫_Ω div u div v,        K_μ = ∫_Ω 2 ε(u) : ε(v),
+
+so the elastic tensor A, the memory tensors C_m and the step matrix
+a_n = A + k R(0) of MODEL.md §5 are all combinations of two matrices
+assembled once. Loads ⟨f(t), v⟩ = (f_0, v)_Ω + (f_N, v)_{Γ_N} are a fixed
+sparse map applied to the load expressions evaluated at fixed quadrature
+points, so a step costs one evaluation and one sparse product.
+"""
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import (Basis, BilinearForm, ElementTetP1, ElementTriP1, ElementVector,
+                   FacetBasis, asm)
+from skfem.helpers import ddot, div, sym_grad
+from skfem.quadrature import get_quadrature
+
+
+@BilinearForm
+def divergence_product(u, v, w):
+    """∫ div u div v: the λ part of the isotropic stiffness."""
+    return div(u) * div(v)
+
+
+@BilinearForm
+def strain_product(u, v, w):
+    """∫ 2 ε(u) : ε(v): the μ part of the isotropic stiffness."""
+    return 2.0 * ddot(sym_grad(u), sym_grad(v))
+
+
+def vector_element(dim):
+    return ElementVector(ElementTriP1() if dim == 2 else ElementTetP1())
+
+
+def stiffness_basis(mesh):
+    """Vector P1 basis with the one-point rule (exact for P1 stiffness)."""
+    elem = vector_element(mesh.dim())
+    return Basis(mesh, elem, quadrature=get_quadrature(elem.refdom, 0))
+
+
+def quadrature_load_map(basis):
+    """Sparse maps M_c with ⟨f, v⟩ = Σ_c M_c f_c(x_q) and the points x_q.
+
+    ``basis`` is a vector (cell or facet) basis; column e·nqp + q of M_c
+    holds φ_{i,c}(x_{eq}) dx_{eq} for the local dofs i of element e.
+    """
+    d = basis.mesh.dim()
+    ne, nqp = basis.dx.shape
+    cols = np.arange(ne * nqp).reshape(ne, nqp)
+    maps = []
+    for c in range(d):
+        rows, vals, cc = [], [], []
+        for i in range(basis.element_dofs.shape[0]):
+            value = basis.basis[i][0].value[c] * basis.dx
+            rows.append(np.broadcast_to(basis.element_dofs[i][:, None], (ne, nqp)).ravel())
+            cc.append(cols.ravel())
+            vals.append(value.ravel())
+        m = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cc))),
+                          shape=(basis.N, ne * nqp))
+        m.eliminate_zeros()
+        maps.append(m)
+    points = basis.global_coordinates().value.reshape(d, -1)
+    return maps, points
+
+
+def strain_map(basis):
+    """Sparse B with (B u) reshaped (ncells, d, d) the cell strains ε(u).
+
+    ``basis`` must use a one-point rule (P1 strains are constant per cell).
+    """
+    d = basis.mesh.dim()
+    ne = basis.mesh.t.shape[1]
+    rows, cols, vals = [], [], []
+    for i in range(basis.element_dofs.shape[0]):
+        grad = basis.basis[i][0].grad[..., 0]  # (d, d, ne): ∂_b u_a
+        eps = 0.5 * (grad + grad.transpose(1, 0, 2))
+        for a in range(d):
+            for b in range(d):
+                rows.append(np.arange(ne) * d * d + a * d + b)
+                cols.append(basis.element_dofs[i])
+                vals.append(eps[a, b])
+    B = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(ne * d * d, basis.N))
+    B.eliminate_zeros()
+    return B
+
+
+class LoadMap:
+    """t -> ⟨f(t), ·⟩ for body forces and side tractions (expressions)."""
+
+    def __init__(self, mesh, body, traction, intorder=4):
+        d = mesh.dim()
+        elem = vector_element(d)
+        self.parts = []
+        if any(not (e.is_constant and float(e(0.0)) == 0.0) for e in body):
+            basis = Basis(mesh, elem, intorder=intorder)
+            self.parts.append((body, *quadrature_load_map(basis)))
+        for side, exprs in traction.items():
+            basis = FacetBasis(mesh, elem, facets=mesh.boundaries[side], intorder=intorder)
+            self.parts.append((exprs, *quadrature_load_map(basis)))
+        self.ndofs = d * mesh.p.shape[1]
+
+    def __call__(self, t):
+        f = np.zeros(self.ndofs)
+        for exprs, maps, x in self.parts:
+            coords = list(x) + [None] * (3 - x.shape[0])
+            for expr, m in zip(exprs, maps):
+                f += m @ expr(coords[0], coords[1], coords[2], t=t)
+        return f
+
+
+class Assembly:
+    """The per-mesh operators of the fully discrete scheme."""
+
+    def __init__(self, mesh):
+        self.mesh = mesh
+        self.dim = mesh.dim()
+        self.basis = stiffness_basis(mesh)
+        self.K_lam = asm(divergence_product, self.basis).tocsr()
+        self.K_mu = asm(strain_product, self.basis).tocsr()
+        self.strain = strain_map(self.basis)
+
+    @property
+    def ndofs(self):
+        return self.basis.N
+
+    def stiffness(self, lam, mu):
+        """λ K_λ + μ K_μ, the stiffness of the isotropic tensor (λ, μ)."""
+        return (lam * self.K_lam + mu * self.K_mu).tocsr()
+
+    def force(self, lam_field, mu_field):
+        """K_λ a + K_μ b: the force of the stress tr ε(a) I + 2 ε(b)."""
+        return self.K_lam @ lam_field + self.K_mu @ mu_field
+
+    def cell_strain(self, u):
+        """ε(u) per cell, shape (ncells, d, d)."""
+        return (self.strain @ u).reshape(-1, self.dim, self.dim)
+
+    def cell_stress(self, lam_field, mu_field):
+        """σ = tr ε(a) I + 2 ε(b) per cell (ncells, d, d)."""
+        ea = self.cell_strain(lam_field)
+        eb = self.cell_strain(mu_field)
+        tr = np.trace(ea, axis1=1, axis2=2)
+        return tr[:, None, None] * np.eye(self.dim) + 2.0 * eb

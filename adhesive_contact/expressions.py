@@ -1,0 +1,275 @@
+"""Restricted evaluation of scalar field expressions.
+
+Scene files give loads, gaps and initial fields as short formulas in the
+coordinates and time, e.g. ``"-40*t"`` or ``"0.02 + 0.01*sin(pi*x)"``.  Such
+strings come from input files and must never reach Python's ``eval``: this
+module parses them with :func:`ast.parse` and accepts only a small arithmetic
+language (numbers, ``x y z t pi e``, ``+ - * / **``, comparisons and a
+whitelist of elementwise NumPy functions).  Everything else -- attribute
+access, subscripts, strings, lambdas, keyword arguments, other names -- is
+rejected when the expression is compiled, so a scene file cannot run code.
+The validated tree is then evaluated by walking it with NumPy arrays.
+
+"""
+import ast
+import numbers
+
+import numpy as np
+
+__all__ = ['ExpressionError', 'Expression', 'compile_expression']
+
+MAX_LENGTH = 2000
+MAX_DEPTH = 100
+VARIABLES = ('x', 'y', 'z', 't')
+CONSTANTS = {'pi': np.pi, 'e': np.e}
+FUNCTIONS = {
+    'sin': np.sin, 'cos': np.cos, 'tan': np.tan, 'arcsin': np.arcsin,
+    'arccos': np.arccos, 'arctan': np.arctan, 'arctan2': np.arctan2,
+    'sinh': np.sinh, 'cosh': np.cosh, 'tanh': np.tanh, 'exp': np.exp,
+    'log': np.log, 'log10': np.log10, 'sqrt': np.sqrt, 'abs': np.abs,
+    'minimum': np.minimum, 'maximum': np.maximum, 'where': np.where,
+    'sign': np.sign, 'floor': np.floor, 'ceil': np.ceil,
+    'heaviside': np.heaviside, 'hypot': np.hypot, 'clip': np.clip,
+}
+ARITY = {name: 1 for name in FUNCTIONS}
+ARITY.update(where=3, clip=3, minimum=2, maximum=2, arctan2=2, hypot=2,
+             heaviside=2)
+BINOPS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply,
+          ast.Div: np.true_divide, ast.Pow: np.power}
+UNARYOPS = {ast.UAdd: np.positive, ast.USub: np.negative}
+COMPAREOPS = {ast.Lt: np.less, ast.LtE: np.less_equal, ast.Gt: np.greater,
+              ast.GtE: np.greater_equal, ast.Eq: np.equal,
+              ast.NotEq: np.not_equal}
+ALLOWED_NAMES = "use x, y, z, t, pi, e or a function (sin, cos, ...)"
+REJECTED = {
+    ast.Attribute: "attribute access is not allowed",
+    ast.Subscript: "subscripts/indexing are not allowed",
+    ast.Lambda: "lambda is not allowed",
+    ast.IfExp: "conditional expressions are not allowed; "
+               "use where(cond, a, b)",
+    ast.BoolOp: "boolean operators (and/or) are not allowed; "
+                "use where(...) with comparisons",
+    ast.Starred: "star arguments are not allowed",
+    ast.NamedExpr: "assignment expressions are not allowed",
+    ast.JoinedStr: "string literals are not allowed",
+}
+for _node in (ast.ListComp, ast.SetComp, ast.DictComp, ast.GeneratorExp):
+    REJECTED[_node] = "comprehensions are not allowed"
+for _node in (ast.Tuple, ast.List, ast.Set, ast.Dict):
+    REJECTED[_node] = "tuple, list, set and dict literals are not allowed"
+
+
+class ExpressionError(ValueError):
+    """Invalid, disallowed or inapplicable field expression."""
+
+
+def _opname(op):
+    return type(op).__name__
+
+
+def _check(node, uses, depth=0):
+    """Validate ``node`` recursively and collect the variables it uses."""
+    if depth > MAX_DEPTH:
+        raise ExpressionError("expression is nested too deeply "
+                              "(more than {} levels)".format(MAX_DEPTH))
+    if type(node) in REJECTED:
+        raise ExpressionError(REJECTED[type(node)])
+    if isinstance(node, ast.Constant):
+        if isinstance(node.value, str):
+            raise ExpressionError("string literals are not allowed")
+        if (isinstance(node.value, bool)
+                or not isinstance(node.value, (int, float))):
+            raise ExpressionError("constant {!r} is not allowed; only real "
+                                  "numbers".format(node.value))
+        try:
+            node.value = float(node.value)  # float math: 9**9**9 -> inf
+        except OverflowError:
+            raise ExpressionError("number literal is too large") from None
+        return
+    if isinstance(node, ast.Name):
+        if node.id in VARIABLES:
+            uses.add(node.id)
+        elif node.id in FUNCTIONS:
+            raise ExpressionError("function '{}' must be called, e.g. {}(x)"
+                                  .format(node.id, node.id))
+        elif node.id not in CONSTANTS:
+            raise ExpressionError("name '{}' is not allowed; {}"
+                                  .format(node.id, ALLOWED_NAMES))
+        return
+    if isinstance(node, ast.BinOp):
+        if type(node.op) not in BINOPS:
+            raise ExpressionError("operator {} is not allowed; use + - * / **"
+                                  .format(_opname(node.op)))
+        children = [node.left, node.right]
+    elif isinstance(node, ast.UnaryOp):
+        if type(node.op) not in UNARYOPS:
+            raise ExpressionError("operator {} is not allowed; use unary + -"
+                                  .format(_opname(node.op)))
+        children = [node.operand]
+    elif isinstance(node, ast.Compare):
+        for op in node.ops:
+            if type(op) not in COMPAREOPS:
+                raise ExpressionError("comparison {} is not allowed; use "
+                                      "< <= > >= == !=".format(_opname(op)))
+        children = [node.left] + node.comparators
+    elif isinstance(node, ast.Call):
+        if isinstance(node.func, ast.Attribute):
+            raise ExpressionError("attribute access is not allowed; "
+                                  "call functions by bare name, e.g. sin(x)")
+        if not isinstance(node.func, ast.Name):
+            raise ExpressionError("only calls to named functions are allowed,"
+                                  " e.g. sin(x)")
+        if node.func.id not in FUNCTIONS:
+            raise ExpressionError("function '{}' is not allowed; allowed: {}"
+                                  .format(node.func.id, ', '.join(FUNCTIONS)))
+        name = node.func.id
+        if node.keywords:
+            raise ExpressionError("keyword arguments are not allowed "
+                                  "(in call to '{}')".format(name))
+        if len(node.args) != ARITY[name]:
+            raise ExpressionError("function '{}' takes {} argument(s), got {}"
+                                  .format(name, ARITY[name], len(node.args)))
+        children = node.args
+    else:
+        raise ExpressionError("{} is not allowed in expressions"
+                              .format(type(node).__name__))
+    for child in children:
+        _check(child, uses, depth + 1)
+
+
+def _float(value):
+    return np.asarray(value, dtype=float)  # booleans take part as 0/1
+
+
+def _eval(node, env):
+    """Evaluate a validated tree with the arrays in ``env``."""
+    if isinstance(node, ast.Constant):
+        return np.float64(node.value)
+    if isinstance(node, ast.Name):
+        return env[node.id]
+    if isinstance(node, ast.BinOp):
+        return BINOPS[type(node.op)](_float(_eval(node.left, env)),
+                                     _float(_eval(node.right, env)))
+    if isinstance(node, ast.UnaryOp):
+        return UNARYOPS[type(node.op)](_float(_eval(node.operand, env)))
+    if isinstance(node, ast.Compare):
+        left, out = _eval(node.left, env), True
+        for op, comparator in zip(node.ops, node.comparators):
+            right = _eval(comparator, env)
+            out = np.logical_and(out, COMPAREOPS[type(op)](left, right))
+            left = right
+        return out
+    return FUNCTIONS[node.func.id](*(_eval(arg, env) for arg in node.args))
+
+
+class Expression:
+    """A compiled restricted expression f(x, y, z, t).
+
+    Attributes
+    ----------
+    source : str
+        The original text.
+    uses : frozenset
+        Which of ``'x', 'y', 'z', 't'`` the expression references.
+
+    """
+
+    def __init__(self, source, tree, uses):
+        self.source = source
+        self.uses = frozenset(uses)
+        self._tree = tree
+
+    @property
+    def is_constant(self):
+        """True if the expression uses none of x, y, z, t."""
+        return not self.uses
+
+    @property
+    def depends_on_time(self):
+        """True if the expression uses t."""
+        return 't' in self.uses
+
+    def __call__(self, x, y=None, z=None, t=0.0):
+        """Evaluate at points ``(x, y, z)`` and time ``t``.
+
+        Parameters
+        ----------
+        x, y, z : ndarray
+            Coordinates of one common shape; ``y`` and ``z`` may be None if
+            the expression does not use them.
+        t : float or ndarray
+            Time (an array broadcastable to the shape of ``x`` is allowed).
+
+        Returns
+        -------
+        ndarray
+            Float array of the shape of ``x``.  Division by zero and the like
+            follow NumPy and may give inf or nan.
+
+        """
+        x = np.asarray(x, dtype=float)
+        env = dict(CONSTANTS, x=x, t=np.asarray(t, dtype=float))
+        for name, value, dim in (('y', y, '1D'), ('z', z, '2D')):
+            if value is None:
+                if name in self.uses:
+                    raise ExpressionError("expression uses '{}' but the "
+                                          "problem is {}".format(name, dim))
+            else:
+                env[name] = np.asarray(value, dtype=float)
+        with np.errstate(all='ignore'):
+            value = _eval(self._tree, env)
+        return np.array(np.broadcast_to(value, x.shape), dtype=float)
+
+    def __repr__(self):
+        return "Expression({!r})".format(self.source)
+
+
+def compile_expression(source):
+    """Parse and validate an expression without evaluating it.
+
+    Parameters
+    ----------
+    source : str, int or float
+        Expression text, or a plain number for a constant expression.
+
+    Returns
+    -------
+    Expression
+        The compiled expression.
+
+    Raises
+    ------
+    ExpressionError
+        If the text is empty, too long, nested too deeply, syntactically
+        invalid or uses anything outside the allowed language.
+
+    """
+    if isinstance(source, Expression):
+        return source
+    if isinstance(source, numbers.Real) and not isinstance(source,
+                                                           (bool, np.bool_)):
+        return Expression(repr(source), ast.Constant(float(source)), ())
+    if not isinstance(source, str):
+        raise ExpressionError("expression must be a string or a number, "
+                              "not {}".format(type(source).__name__))
+    if not source.strip():
+        raise ExpressionError("expression is empty")
+    if len(source) > MAX_LENGTH:
+        raise ExpressionError("expression is too long (more than {} "
+                              "characters)".format(MAX_LENGTH))
+    level = 0
+    for char in source:  # protect the parser from deep bracket nesting
+        level += (char in '([{') - (char in ')]}')
+        if level > MAX_DEPTH:
+            raise ExpressionError("expression is nested too deeply (more "
+                                  "than {} levels)".format(MAX_DEPTH))
+    try:
+        tree = ast.parse(source.strip(), mode="eval").body
+    except SyntaxError as err:
+        raise ExpressionError("invalid syntax in expression {!r}: {}".format(
+            source[:60], err.msg)) from None
+    except (RecursionError, MemoryError):
+        raise ExpressionError("expression is nested too deeply") from None
+    uses = set()
+    _check(tree, uses)
+    return Expression(source, tree, uses)

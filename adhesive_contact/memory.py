@@ -1,0 +1,112 @@
+"""The memory term: the right rectangle rule for ∫_0^t R(t−s) ε(u(s)) ds.
+
+At step n the scheme (4.1) needs k Σ_{j=1}^{n} R(t_n − t_j) ε(u_j). The
+j = n term k R(0) ε(u_n) joins the step matrix; the rest, the history, is
+known. Because ε is linear, the history of an isotropic kernel is the
+strain of a displacement-like field, so it is stored as two nodal vectors
+(a_λ, a_μ) whose force is K_λ a_λ + K_μ a_μ and whose stress is
+tr ε(a_λ) I + 2 ε(a_μ) (see :mod:`adhesive_contact.assembly`).
+
+- Prony series R(t) = Σ_m e^{−t/τ_m} C_m (MODEL.md §6): with
+  h_n^m = k Σ_{j<n} e^{−(t_n−t_j)/τ_m} u_j one has h_1^m = 0 and
+  h_n^m = e^{−k/τ_m} (h_{n−1}^m + k u_{n−1}) exactly: O(1) per step.
+- A scalar kernel R(t) = r(t) C_0: the history k Σ_{j<n} r(t_n − t_j) u_j
+  is summed directly, O(n) per step.
+
+Each object keeps the state of one run: ``begin(k, ndofs)``, then per step
+``history(n)`` before solving for u_n and ``advance(n, u_n)`` after.
+"""
+
+import numpy as np
+
+
+class NoMemory:
+    """No memory: R ≡ 0."""
+
+    active = False
+
+    def instantaneous(self, k):
+        """(λ, μ) of k R(0), the tensor that joins the step matrix."""
+        return 0.0, 0.0
+
+    def begin(self, k, ndofs):
+        self.ndofs = ndofs
+
+    def history(self, n):
+        """(a_λ, a_μ) of the history at step n, or None when it is zero."""
+        return None
+
+    def advance(self, n, u):
+        pass
+
+
+class PronyMemory:
+    """R(t) = Σ_m e^{−t/τ_m} C_m with C_m = (λ_m, μ_m); exact recursion."""
+
+    active = True
+
+    def __init__(self, lam, mu, tau):
+        self.lam = np.asarray(lam, dtype=float)
+        self.mu = np.asarray(mu, dtype=float)
+        self.tau = np.asarray(tau, dtype=float)
+
+    def instantaneous(self, k):
+        return k * self.lam.sum(), k * self.mu.sum()
+
+    def begin(self, k, ndofs):
+        self.k = k
+        self.decay = np.exp(-k / self.tau)
+        self.h = np.zeros((self.tau.size, ndofs))  # h_1^m = 0
+
+    def history(self, n):
+        """(a_λ, a_μ) = (Σ_m λ_m h_n^m, Σ_m μ_m h_n^m)."""
+        return self.lam @ self.h, self.mu @ self.h
+
+    def advance(self, n, u):
+        """h_{n+1}^m = e^{−k/τ_m} (h_n^m + k u_n)."""
+        self.h += self.k * u[None, :]
+        self.h *= self.decay[:, None]
+
+
+class FunctionMemory:
+    """R(t) = r(t) C_0 with C_0 = (λ_0, μ_0); the history summed directly."""
+
+    active = True
+
+    def __init__(self, r, lam, mu):
+        self.r = r
+        self.lam = lam
+        self.mu = mu
+
+    def _r(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return self.r(t, t=t)
+
+    def instantaneous(self, k):
+        r0 = float(self._r(0.0)[0])
+        return k * r0 * self.lam, k * r0 * self.mu
+
+    def begin(self, k, ndofs):
+        self.k = k
+        self.u = []  # u_1, u_2, ...
+
+    def history(self, n):
+        if n == 1:
+            return None
+        lags = self.k * (n - np.arange(1, n))  # t_n − t_j, j = 1..n−1
+        a = self.k * (self._r(lags) @ np.asarray(self.u))
+        return self.lam * a, self.mu * a
+
+    def advance(self, n, u):
+        self.u.append(u.copy())
+
+
+def make_memory(spec):
+    """The memory object of a scene's MemorySpec (None: no memory)."""
+    if spec is None:
+        return NoMemory()
+    if spec.kernel == "prony":
+        return PronyMemory([t.tensor.lam for t in spec.terms],
+                           [t.tensor.mu for t in spec.terms],
+                           [t.tau for t in spec.terms])
+    return FunctionMemory(spec.function, spec.tensor.lam, spec.tensor.mu)

@@ -1,0 +1,130 @@
+"""A scene made discrete: everything built once before the time loop.
+
+:func:`build_problem` turns a :class:`~adhesive_contact.scene.Scene` into
+a :class:`Problem`: the mesh and its per-mesh operators, the free and
+clamped dofs, Γ_C (only if the scene has contact terms), the load map, the
+gap at the contact nodes for every t_n, the initial bonding β_0^h = P_B β_0,
+the memory and the probes. Checks that need the geometry (a probe outside
+the mesh, a negative gap) raise :class:`~adhesive_contact.scene.SceneError`.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import Basis, ElementTetP1, ElementTriP1
+
+from .assembly import Assembly, LoadMap
+from .contact_boundary import build_contact_boundary, reference_facet_rule
+from .laws import make_normal_law
+from .memory import make_memory
+from .mesh import build_mesh
+from .scene import SceneError
+
+
+@dataclass
+class Problem:
+    scene: object
+    mesh: object
+    assembly: Assembly
+    free: np.ndarray          # free dofs
+    clamped: np.ndarray       # dofs on Γ_D
+    boundary: object          # ContactBoundary, or None
+    contact_positions: np.ndarray  # positions of the contact dofs within ``free``
+    loads: LoadMap
+    gap: np.ndarray           # (N+1, nc) g(x_a, t_n), or None for no wall
+    beta0: np.ndarray         # (nf,) β_0^h
+    normal_law: object
+    memory: object
+    probe_map: object         # sparse (nprobes, npoints) or None
+    times: np.ndarray         # t_n, n = 0..N
+    assembly_seconds: float
+
+    @property
+    def dim(self):
+        return self.mesh.dim()
+
+    @property
+    def ndofs(self):
+        return self.assembly.ndofs
+
+    def upper_bound(self, n):
+        """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
+        nz = self.boundary.n_unknowns
+        upper = np.full(nz, np.inf)
+        if self.gap is not None:
+            upper[self.boundary.normal_unknowns] = self.gap[n]
+        return upper
+
+
+def _coords(points):
+    d = points.shape[0]
+    return [points[i] if i < d else None for i in range(3)]
+
+
+def _facet_mean(mesh, boundary, expr, order=4):
+    """P_B of an expression: its mean over each contact facet (Gauss rule)."""
+    d = mesh.dim()
+    shapes, weights = reference_facet_rule(d, "gauss", order)
+    x = np.einsum("qv,dvf->dfq", shapes, mesh.p[:, boundary.facet_nodes])
+    values = expr(*_coords(x.reshape(d, -1))).reshape(x.shape[1:])
+    return values @ weights
+
+
+def build_problem(scene):
+    """Discretise a scene (see module docstring)."""
+    t0 = time.perf_counter()
+    mesh = build_mesh(scene.mesh)
+    assembly = Assembly(mesh)
+    basis = assembly.basis
+    d = mesh.dim()
+
+    dirichlet_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
+    clamped_nodes = np.unique(mesh.facets[:, dirichlet_facets])
+    clamped = np.sort(basis.nodal_dofs[:, clamped_nodes].ravel())
+    free = np.setdiff1d(np.arange(basis.N), clamped)
+    position = np.full(basis.N, -1)
+    position[free] = np.arange(free.size)
+
+    times = scene.k * np.arange(scene.steps + 1)
+    boundary, contact_positions, gap = None, np.zeros(0, dtype=np.int64), None
+    beta0 = np.zeros(0)
+    if scene.has_contact_terms:
+        facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
+        boundary = build_contact_boundary(mesh, facets, clamped_nodes,
+                                          scene.contact.quadrature, scene.contact.order)
+        assert np.array_equal(basis.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
+        contact_positions = position[boundary.dofs.ravel()]
+        if scene.contact.gap is not None:
+            x = _coords(mesh.p[:, boundary.nodes])
+            gap = np.array([scene.contact.gap(*x, t=t) for t in times])
+            bad = ~(np.isfinite(gap) & (gap >= 0))
+            if bad.any():
+                n, a = np.argwhere(bad)[0]
+                where = ", ".join(f"{c:g}" for c in mesh.p[:, boundary.nodes[a]])
+                raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
+                                 f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
+        beta0 = np.ones(boundary.facets.size)
+        if scene.contact.beta0 is not None:
+            beta0 = _facet_mean(mesh, boundary, scene.contact.beta0)
+            if not np.all((beta0 >= 0) & (beta0 <= 1)):
+                raise SceneError("contact.bonding.beta0", "must lie in [0, 1] on Γ_C")
+
+    probe_map = None
+    if scene.probes:
+        scalar = Basis(mesh, ElementTriP1() if d == 2 else ElementTetP1())
+        points = np.array(scene.probes, dtype=float).T
+        for i in range(points.shape[1]):
+            try:
+                scalar.probes(points[:, i:i + 1])
+            except ValueError:
+                raise SceneError(f"output.probes[{i}]", "point "
+                                 f"({', '.join(f'{c:g}' for c in points[:, i])}) "
+                                 "is outside the mesh") from None
+        probe_map = scalar.probes(points).tocsr()
+
+    loads = LoadMap(mesh, scene.body, scene.traction)
+    return Problem(scene, mesh, assembly, free, clamped, boundary, contact_positions, loads,
+                   gap, beta0, make_normal_law(scene.contact.normal.law,
+                                               scene.contact.normal.params),
+                   make_memory(scene.memory), probe_map, times, time.perf_counter() - t0)

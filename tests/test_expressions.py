@@ -1,0 +1,181 @@
+"""Tests for the restricted expression evaluator."""
+import ast
+import inspect
+
+import numpy as np
+import pytest
+
+from adhesive_contact import expressions
+from adhesive_contact.expressions import (Expression, ExpressionError,
+                                          compile_expression)
+
+X = np.linspace(0.0, 2.0, 11)
+Y = np.linspace(-1.0, 1.0, 11)
+Z = np.linspace(3.0, 4.0, 11)
+
+
+@pytest.mark.parametrize("source, expected", [
+    ("0.02 + 0.01*sin(pi*x)", 0.02 + 0.01 * np.sin(np.pi * X)),
+    ("-40*t", np.full_like(X, -40 * 0.5)),
+    ("x**2 - 3*y/2 + z", X**2 - 3 * Y / 2 + Z),
+    ("exp(-x)*cos(e*y)", np.exp(-X) * np.cos(np.e * Y)),
+    ("arctan2(y, x + 1)", np.arctan2(Y, X + 1)),
+    ("hypot(x, y)", np.hypot(X, Y)),
+    ("minimum(x, 1) + maximum(y, 0)", np.minimum(X, 1) + np.maximum(Y, 0)),
+    ("clip(x, 0.5, 1.5)", np.clip(X, 0.5, 1.5)),
+    ("heaviside(x - 1, 0.5)", np.heaviside(X - 1, 0.5)),
+    ("sqrt(abs(y)) * sign(y)", np.sqrt(np.abs(Y)) * np.sign(Y)),
+    ("floor(3*x) + ceil(3*y) + log10(z) + log(z)",
+     np.floor(3 * X) + np.ceil(3 * Y) + np.log10(Z) + np.log(Z)),
+    ("tanh(x) + sinh(y) - cosh(y) + tan(y) + arcsin(y) + arccos(y)"
+     " + arctan(x)",
+     np.tanh(X) + np.sinh(Y) - np.cosh(Y) + np.tan(Y) + np.arcsin(Y)
+     + np.arccos(Y) + np.arctan(X)),
+    ("where(x < 1, 1.0, 0.0)", np.where(X < 1, 1.0, 0.0)),
+    ("where(x >= 1, x, -x)", np.where(X >= 1, X, -X)),
+    ("where(0.5 < x <= 1.5, 2, 0)",
+     np.where((X > 0.5) & (X <= 1.5), 2.0, 0.0)),
+    ("where(y == 0, 7, where(y != 0, 1, 2))", np.where(Y == 0, 7.0, 1.0)),
+    ("(x < 1)*3 - (x > 1)", (X < 1) * 3.0 - (X > 1)),
+    ("+x - -y", X + Y),
+    ("2**-1 * x", 0.5 * X),
+])
+def test_values_match_numpy(source, expected):
+    out = compile_expression(source)(X, Y, Z, t=0.5)
+    assert out.dtype == float
+    assert out.shape == X.shape
+    np.testing.assert_allclose(out, expected, rtol=1e-14, atol=1e-15)
+
+
+@pytest.mark.parametrize("source", ["3", "pi/2", "-40*t", 2.5, 7])
+def test_constant_and_time_only_broadcast_to_shape_of_x(source):
+    x = np.zeros((4, 3))
+    out = compile_expression(source)(x, t=2.0)
+    assert isinstance(out, np.ndarray)
+    assert out.shape == (4, 3)
+    assert out.dtype == float
+    assert np.all(out == out.flat[0])
+    out[0, 0] = 123.0  # the result is writeable, not a broadcast view
+    assert out[1, 1] != 123.0
+
+
+def test_number_input():
+    expr = compile_expression(2.5)
+    np.testing.assert_array_equal(expr(X), np.full_like(X, 2.5))
+    assert expr.is_constant and not expr.depends_on_time
+    assert compile_expression(3)(X).dtype == float
+    with pytest.raises(ExpressionError):
+        compile_expression(True)
+    with pytest.raises(ExpressionError):
+        compile_expression(None)
+
+
+def test_uses_and_flags():
+    expr = compile_expression("0.02 + 0.01*sin(pi*x) * t")
+    assert isinstance(expr, Expression)
+    assert expr.source == "0.02 + 0.01*sin(pi*x) * t"
+    assert expr.uses == frozenset({'x', 't'})
+    assert not expr.is_constant and expr.depends_on_time
+    expr = compile_expression("hypot(y, z)")
+    assert expr.uses == frozenset({'y', 'z'})
+    assert not expr.depends_on_time
+    expr = compile_expression("2*pi + e")
+    assert expr.uses == frozenset() and expr.is_constant
+    assert compile_expression("-40*t").uses == frozenset({'t'})
+
+
+def test_time_argument():
+    expr = compile_expression("-40*t + x")
+    np.testing.assert_allclose(expr(X, t=0.25), X - 10.0)
+    np.testing.assert_allclose(expr(X), X)  # t defaults to 0
+
+
+def test_missing_coordinate():
+    with pytest.raises(ExpressionError,
+                       match="uses 'z' but the problem is 2D"):
+        compile_expression("x + z")(X, Y)
+    with pytest.raises(ExpressionError, match="uses 'y'"):
+        compile_expression("y")(X)
+    # unused coordinates may be None
+    np.testing.assert_allclose(compile_expression("2*x")(X, None, None), 2 * X)
+
+
+def test_numpy_semantics_for_division_by_zero():
+    with np.errstate(all='raise'):  # warnings must be silenced inside
+        inv = compile_expression("1/x")(X)
+        big = compile_expression("9**9**9")(X)
+        log0 = compile_expression("log(x - x)")(X)
+        nan = compile_expression("0/x")(X)
+    assert inv[0] == np.inf and np.isfinite(inv[1:]).all()
+    assert np.all(big == np.inf)
+    assert np.all(log0 == -np.inf)
+    assert np.isnan(nan[0]) and np.all(nan[1:] == 0.0)
+
+
+@pytest.mark.parametrize("source, name, nargs", [
+    ("where(x < 1, 1)", "where", 3),
+    ("minimum(x)", "minimum", 2),
+    ("clip(x, 1)", "clip", 3),
+    ("sin(x, y)", "sin", 1),
+    ("hypot(x)", "hypot", 2),
+])
+def test_arity(source, name, nargs):
+    with pytest.raises(ExpressionError,
+                       match=r"'{}' takes {} argument".format(name, nargs)):
+        compile_expression(source)
+
+
+@pytest.mark.parametrize("source, message", [
+    ("__import__('os').system('ls')", "attribute access"),
+    ("__import__('os')", "function '__import__' is not allowed"),
+    ("x.__class__", "attribute access"),
+    ("().__class__", "attribute access"),
+    ("[1,2][0]", "subscript"),
+    ("x[0]", "subscript"),
+    ("lambda: 1", "lambda"),
+    ("(lambda: 1)()", "named functions"),
+    ("[x for x in y]", "comprehension"),
+    ("'a'", "string"),
+    ("f'{x}'", "string"),
+    ("q + 1", "name 'q' is not allowed; use x, y, z, t, pi, e"),
+    ("os", "name 'os' is not allowed"),
+    ("sin(x, y)", "'sin' takes 1 argument"),
+    ("sin(x=1)", "keyword arguments"),
+    ("sin(*x)", "star"),
+    ("x if t else y", "conditional expression"),
+    ("x and y", "boolean operators"),
+    ("not x", "operator Not"),
+    ("x // 2", "operator FloorDiv"),
+    ("x in y", "comparison In"),
+    ("True", "constant True"),
+    ("1j", "constant 1j"),
+    ("(x, y)", "tuple"),
+    ("sin", "function 'sin' must be called"),
+    ("open('f')", "function 'open' is not allowed"),
+    ("np.sin(x)", "attribute access"),
+    ("(y := 1)", "assignment"),
+    ("", "empty"),
+    ("   ", "empty"),
+    ("1 +", "invalid syntax"),
+    ("import os", "invalid syntax"),
+    ("(" * 200 + "x" + ")" * 200, "nested too deeply"),
+    ("-" * 1999 + "x", "nested too deeply"),
+    ("sin(" * 300 + "x" + ")" * 300, "nested too deeply"),
+    ("-" * 150 + "x", "nested too deeply"),
+    ("sin(" * 120 + "x" + ")" * 120, "nested too deeply"),
+    ("x" + "+x" * 1000, "too long"),
+])
+def test_rejected(source, message):
+    with pytest.raises(ExpressionError, match=message) as info:
+        compile_expression(source)
+    assert isinstance(info.value, ValueError)
+    assert "\n" not in str(info.value)
+
+
+def test_no_builtin_eval_exec_compile_in_module():
+    tree = ast.parse(inspect.getsource(expressions))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+            assert node.func.id not in {"eval", "exec", "compile",
+                                        "__import__"}, node.func.id
+    assert "builtins" not in inspect.getsource(expressions)
