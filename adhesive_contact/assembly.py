@@ -55,7 +55,7 @@ def quadrature_load_map(basis):
     for c in range(d):
         rows, vals, cc = [], [], []
         for i in range(basis.element_dofs.shape[0]):
-            value = basis.basis[i][0].value[c] * basis.dx
+            value = np.asarray(basis.basis[i][0])[c] * basis.dx
             rows.append(np.broadcast_to(basis.element_dofs[i][:, None], (ne, nqp)).ravel())
             cc.append(cols.ravel())
             vals.append(value.ravel())
@@ -63,7 +63,7 @@ def quadrature_load_map(basis):
                           shape=(basis.N, ne * nqp))
         m.eliminate_zeros()
         maps.append(m)
-    points = basis.global_coordinates().value.reshape(d, -1)
+    points = np.asarray(basis.global_coordinates()).reshape(d, -1)
     return maps, points
 
 
