@@ -95,6 +95,8 @@ class ContactBoundary:
     normal_trace : (nq, nz) sparse N, z -> u_ν at the points
     tangential_trace : list of d-1 sparse (nq, nz), z -> u_τ components
     node_weights : (nc,) lumped nodal weights ∫ φ_a over Γ_C
+    point_node : (nq,) contact node read by each point of the nodal rule
+        (−1 for a clamped vertex, and for every point of a Gauss rule)
     """
 
     dim: int
@@ -110,6 +112,7 @@ class ContactBoundary:
     normal_trace: sp.csr_matrix
     tangential_trace: list
     node_weights: np.ndarray
+    point_node: np.ndarray
 
     @property
     def n_unknowns(self):
@@ -120,14 +123,21 @@ class ContactBoundary:
         """Indices into z of the normal components z_{a,0} = u_ν(x_a)."""
         return np.arange(self.nodes.size) * self.dim
 
-    def rotation(self):
-        """Block-diagonal Q (nc·d × nc·d) with u_C = Q z, u_C node-major."""
+    def rotation(self, ndofs):
+        """Sparse R (ndofs × ndofs): u = R ũ with ũ the nodal-frame components
+        at the contact nodes and the Cartesian ones elsewhere (R orthogonal)."""
         nc, d = self.nodes.size, self.dim
-        rows = (np.arange(nc)[:, None, None] * d + np.arange(d)[None, :, None])
-        cols = (np.arange(nc)[:, None, None] * d + np.arange(d)[None, None, :])
-        return sp.csr_matrix((self.frame.ravel(), (np.broadcast_to(rows, self.frame.shape).ravel(),
-                                                   np.broadcast_to(cols, self.frame.shape).ravel())),
-                             shape=(nc * d, nc * d))
+        other = np.setdiff1d(np.arange(ndofs), self.dofs.ravel())
+        rows = np.broadcast_to(self.dofs[:, :, None], (nc, d, d))  # (a, i, c): R[dof_ai, dof_ac]
+        cols = np.broadcast_to(self.dofs[:, None, :], (nc, d, d))
+        return sp.csr_matrix((np.concatenate([self.frame.ravel(), np.ones(other.size)]),
+                              (np.concatenate([rows.ravel(), other]),
+                               np.concatenate([cols.ravel(), other]))), shape=(ndofs, ndofs))
+
+    def unknowns(self, components):
+        """Indices (node-major, nc·d) of the given frame components of every node."""
+        comps = np.asarray(components)
+        return (np.arange(self.nodes.size)[:, None] * self.dim + comps[None, :]).ravel()
 
     def at_points(self, facet_values):
         """A P0 field (nf,) read at the quadrature points (nq,)."""
@@ -165,14 +175,10 @@ def build_contact_boundary(mesh, contact_facets, clamped_nodes, quadrature="noda
     points = np.einsum("qv,dfv->dfq", shapes, mesh.p[:, facet_nodes].transpose(0, 2, 1)
                        ).reshape(d, -1)
 
-    # the direction (d, nq) whose component is read at each point
-    if quadrature == "nodal":
-        # point (f, v) reads node facet_nodes[v, f] in its own frame
-        point_node = facet_nodes.T  # (nf, d): vertex v of facet f
-        directions = None
-    else:
-        facet_frame = tangent_frame(normal_f)  # (nf, d, d)
-        directions = np.repeat(facet_frame, nq_ref, axis=0)  # (nq, d, d)
+    # nodal: point (f, v) reads node facet_nodes[v, f] in its own frame;
+    # gauss: the point reads the P1 interpolant in the facet's frame
+    if quadrature == "gauss":
+        directions = np.repeat(tangent_frame(normal_f), nq_ref, axis=0)  # (nq, d, d)
 
     nz = nodes.size * d
     traces = []
@@ -211,4 +217,6 @@ def build_contact_boundary(mesh, contact_facets, clamped_nodes, quadrature="noda
         dim=d, facets=facets, facet_nodes=facet_nodes, measure=measure, nodes=nodes,
         frame=frame, dofs=dofs, weights=weights, facet_of_point=facet_of_point,
         points=points, normal_trace=traces[0], tangential_trace=traces[1:],
-        node_weights=node_weights[nodes])
+        node_weights=node_weights[nodes],
+        point_node=(local[facet_nodes.T].ravel() if quadrature == "nodal"
+                    else np.full(nf * nq_ref, -1)))

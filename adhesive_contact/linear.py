@@ -6,10 +6,10 @@ on the free dofs. Splitting them into contact dofs C and the rest I,
 
     S = A_CC − A_CI A_II⁻¹ A_IC,    c = b_C − A_CI A_II⁻¹ b_I,
 
-the minimisation over u becomes one over the contact unknowns only,
-½ zᵀ (Qᵀ S Q) z − (Qᵀ c)ᵀ z + contact terms, with u_C = Q z in the nodal
-frames of :mod:`adhesive_contact.contact_boundary`; then
-u_I = A_II⁻¹ (b_I − A_IC u_C). A_II is factorised and S formed once per
+the minimisation over u becomes one over the contact unknowns z = u_C
+only, ½ zᵀ S z − cᵀ z + contact terms; then u_I = A_II⁻¹ (b_I − A_IC z).
+(The caller writes the system in the nodal frames of
+:mod:`adhesive_contact.contact_boundary`, so z are frame components.) A_II is factorised and S formed once per
 mesh and step size; a step costs two solves with the factors.
 """
 
@@ -42,14 +42,12 @@ class CondensedOperator:
     A : sparse (nfree, nfree)
         The step matrix restricted to the free dofs.
     contact : (nC,) int
-        Positions, within the free dofs, of the contact dofs (node-major).
-    Q : sparse (nC, nC)
-        The rotation u_C = Q z.
+        Positions, within the free dofs, of the contact unknowns.
     chunk : int
         Right-hand sides per block solve when forming S.
     """
 
-    def __init__(self, A, contact, Q, chunk=128):
+    def __init__(self, A, contact, chunk=128):
         t0 = time.perf_counter()
         n = A.shape[0]
         self.contact = np.asarray(contact, dtype=np.int64)
@@ -60,7 +58,6 @@ class CondensedOperator:
         A_II = A[self.interior][:, self.interior]
         self.A_IC = A[self.interior][:, self.contact].tocsc()
         self.A_CI = self.A_IC.T.tocsr()
-        self.Q = Q
         self.solver = DirectSolver(A_II)
         self.factor_seconds = time.perf_counter() - t0
 
@@ -71,21 +68,19 @@ class CondensedOperator:
             cols = slice(start, min(start + chunk, nC))
             X = self.solver.solve(self.A_IC[:, cols].toarray())
             S[:, cols] -= self.A_CI @ X
-        S = 0.5 * (S + S.T)
-        self.S = Q.T @ (Q.T @ S).T if nC else S  # Qᵀ S Q, S symmetric
+        self.S = 0.5 * (S + S.T)
         self.schur_seconds = time.perf_counter() - t0
 
     def reduce(self, b):
-        """Qᵀ (b_C − A_CI A_II⁻¹ b_I) for a load b on the free dofs."""
+        """c = b_C − A_CI A_II⁻¹ b_I for a load b on the free dofs."""
         if self.contact.size == 0:
             return np.zeros(0)
         y = self.solver.solve(b[self.interior])
-        return self.Q.T @ (b[self.contact] - self.A_CI @ y)
+        return b[self.contact] - self.A_CI @ y
 
     def expand(self, z, b):
-        """The free-dof solution u with u_C = Q z and u_I = A_II⁻¹(b_I − A_IC u_C)."""
+        """The free-dof solution u with u_C = z and u_I = A_II⁻¹(b_I − A_IC z)."""
         u = np.empty(b.size)
-        uC = self.Q @ z if self.contact.size else np.zeros(0)
-        u[self.contact] = uC
-        u[self.interior] = self.solver.solve(b[self.interior] - self.A_IC @ uC)
+        u[self.contact] = z
+        u[self.interior] = self.solver.solve(b[self.interior] - self.A_IC @ z)
         return u

@@ -16,7 +16,7 @@ from skfem import Basis, ElementTetP1, ElementTriP1
 
 from .assembly import Assembly, LoadMap
 from .contact_boundary import build_contact_boundary, reference_facet_rule
-from .laws import make_normal_law
+from .laws import make_bonding, make_friction, make_normal_law
 from .memory import make_memory
 from .mesh import build_mesh
 from .scene import SceneError
@@ -30,11 +30,14 @@ class Problem:
     free: np.ndarray          # free dofs
     clamped: np.ndarray       # dofs on Γ_D
     boundary: object          # ContactBoundary, or None
-    contact_positions: np.ndarray  # positions of the contact dofs within ``free``
+    columns: np.ndarray       # the step's unknowns among the nc·d frame components
+    contact_positions: np.ndarray  # positions of those unknowns within ``free``
     loads: LoadMap
     gap: np.ndarray           # (N+1, nc) g(x_a, t_n), or None for no wall
     beta0: np.ndarray         # (nf,) β_0^h
     normal_law: object
+    friction: object          # FrictionSum or None
+    bonding: object           # bonding law or None (β frozen)
     memory: object
     probe_map: object         # sparse (nprobes, npoints) or None
     times: np.ndarray         # t_n, n = 0..N
@@ -48,12 +51,16 @@ class Problem:
     def ndofs(self):
         return self.assembly.ndofs
 
+    @property
+    def normal_columns(self):
+        """Positions within the step's unknowns of the normal components."""
+        return np.flatnonzero(self.columns % self.dim == 0)
+
     def upper_bound(self, n):
         """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
-        nz = self.boundary.n_unknowns
-        upper = np.full(nz, np.inf)
+        upper = np.full(self.columns.size, np.inf)
         if self.gap is not None:
-            upper[self.boundary.normal_unknowns] = self.gap[n]
+            upper[self.normal_columns] = self.gap[n]
         return upper
 
 
@@ -87,14 +94,22 @@ def build_problem(scene):
     position[free] = np.arange(free.size)
 
     times = scene.k * np.arange(scene.steps + 1)
-    boundary, contact_positions, gap = None, np.zeros(0, dtype=np.int64), None
-    beta0 = np.zeros(0)
+    friction = make_friction(scene.contact.friction)
+    boundary, gap, beta0 = None, None, np.zeros(0)
+    columns = contact_positions = np.zeros(0, dtype=np.int64)
     if scene.has_contact_terms:
         facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
         boundary = build_contact_boundary(mesh, facets, clamped_nodes,
                                           scene.contact.quadrature, scene.contact.order)
         assert np.array_equal(basis.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
-        contact_positions = position[boundary.dofs.ravel()]
+        # without friction only u_ν enters the contact terms (the traces of
+        # the tangential components vanish on flat facets): solve for it alone
+        tangential = boundary.unknowns(np.arange(1, d))
+        normal_only = friction is None and (
+            tangential.size == 0
+            or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
+        columns = boundary.unknowns([0] if normal_only else np.arange(d))
+        contact_positions = position[boundary.dofs.ravel()[columns]]
         if scene.contact.gap is not None:
             x = _coords(mesh.p[:, boundary.nodes])
             gap = np.array([scene.contact.gap(*x, t=t) for t in times])
@@ -124,7 +139,7 @@ def build_problem(scene):
         probe_map = scalar.probes(points).tocsr()
 
     loads = LoadMap(mesh, scene.body, scene.traction)
-    return Problem(scene, mesh, assembly, free, clamped, boundary, contact_positions, loads,
-                   gap, beta0, make_normal_law(scene.contact.normal.law,
-                                               scene.contact.normal.params),
-                   make_memory(scene.memory), probe_map, times, time.perf_counter() - t0)
+    return Problem(scene, mesh, assembly, free, clamped, boundary, columns, contact_positions,
+                   loads, gap, beta0, make_normal_law(scene.contact.normal), friction,
+                   make_bonding(scene.contact.bonding), make_memory(scene.memory),
+                   probe_map, times, time.perf_counter() - t0)

@@ -115,7 +115,8 @@ class Scene:
         """Whether Γ_C carries anything: a wall, a normal law or friction."""
         c = self.contact
         return bool(self.contact_sides) and (
-            c.gap is not None or c.normal.law != "none" or len(c.friction) > 0)
+            c.gap is not None or c.normal.law != "none" or len(c.friction) > 0
+            or c.bonding.law != "none")
 
 
 class _Table:
@@ -250,6 +251,10 @@ def _law(table, registry, variables):
         elif constraint == "nonnegative" and value < 0:
             raise SceneError(table.key(pname), f"must be >= 0, got {value:g}")
         params[pname] = value
+    check = getattr(registry[name][0], "check", None)
+    problem = check(params) if check else None
+    if problem:
+        raise SceneError(table.key(problem[0]), problem[1])
     return LawSpec(name, params)
 
 
@@ -360,9 +365,16 @@ def _read_contact(table, dim, coords):
             if beta0.is_constant and not 0.0 <= float(beta0(0.0)) <= 1.0:
                 raise SceneError(bonding_table.key("beta0"), f"must lie in [0, 1], got {source}")
             resolved["beta0"] = source
+        integrator = _choice(bonding_table.key("integrator"),
+                             bonding_table.get("integrator", "str", "explicit"), ("explicit",))
+        resolved["integrator"] = integrator
         bonding_table.finish()
     resolved["bonding"] = {"law": bonding.law, **bonding.params}
     table.finish()
+    kinked = [f.law for f in friction if f.law in ("tresca", "nonmonotone")]
+    if quadrature == "gauss" and kinked:
+        raise SceneError(table.key("quadrature"), f"'gauss' takes smooth friction laws only "
+                         f"(power, adhesive_spring); {kinked[0]!r} needs 'nodal'")
     return ContactSpec(gap, quadrature, order, normal, tuple(friction), bonding, beta0), resolved
 
 

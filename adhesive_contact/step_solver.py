@@ -1,70 +1,41 @@
 """The nonsmooth step solve of (4.1) on the contact unknowns.
 
 With the interior condensed out (:mod:`adhesive_contact.linear`), a step
-is the minimisation of MODEL.md §5 over the contact unknowns z,
+minimises the energy of MODEL.md §5 over the contact unknowns z,
 
     E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z_ν ≤ g  (the wall),
 
-Φ(z) = Σ_q w_q [P_ν(β_q, (N z)_q) + j_τ(β_q, (T z)_q)] the contact terms
-(:class:`ContactEnergy`). It is solved by a projected semismooth Newton
-method (Bertsekas' two-metric projection for the bounds) with an Armijo
-line search on E along the projection arc:
+with Φ the contact terms (:class:`~adhesive_contact.contact_energy.ContactEnergy`).
+Friction laws with a kink at ξ = 0 (Tresca, slip weakening) add, at each
+contact node a, a term with Clarke subdifferential B(0, κ_a) at ξ_a = 0.
 
-- the binding set A = {i : z_i ≥ g_i − ε_k, ∂_i E < 0} is held on the wall,
-- on the rest F a Newton step H_FF d_F = −∇_F E with H = S + ∂²Φ (an
-  element of the generalised Hessian at kinks),
-- z(α) = min(z + α d, g), halving α until
-  E(z(α)) ≤ E(z) + σ ∇E · (z(α) − z).
+The method is a projected semismooth Newton iteration with an Armijo line
+search on E, combining Bertsekas' two-metric projection for the wall with
+the orthant-wise treatment of the kink (as in OWL-QN):
 
-It stops when the projected gradient (∇E with the wall's pull removed on
-the binding set) is below ``tol`` times the force scale of the step. The
-wall multiplier λ_i = −∂_i E ≥ 0 on the binding set is the wall's reaction.
+- the binding set: z_i within ε of the wall and ∂_i E < 0 — moved onto it
+  and held there;
+- the stick set: |ξ_a| ≤ ε and |h_a| ≤ κ_a, h_a the gradient without the
+  kink — ξ_a is set to 0 and held there;
+- every other node slips with its direction ê_a = ξ_a/|ξ_a| held for the
+  step (or, at ξ_a = 0, ê_a = −(pseudo-gradient)): a trial ξ_a that turns
+  against ê_a is put to 0, so the sign of ξ/|ξ| cannot flip inside a step;
+- on the free coordinates a Newton step with H = S + ∂²Φ (a modified
+  Cholesky when H is indefinite, e.g. under strong slip weakening),
+  coupled to the fixed coordinates' moves;
+- z(α) projected as above, α halved until
+  E(z(α)) ≤ E(z) + σ E'(z; z(α) − z) (up to the round-off of E, so that
+  the full step is taken once the decrease is below what E can resolve).
+
+It stops when the pseudo-gradient (the minimal-norm element of
+∂E + normal cone of the wall) is below ``tol`` times the force scale of
+the step, and returns the wall multipliers λ = −∂_ν E ≥ 0 on the wall.
 """
 
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as la
-import scipy.sparse as sp
-
-
-class ContactEnergy:
-    """Φ(z) = Σ_q w_q P_ν(β_q, (N z)_q) for the normal law of a step.
-
-    Parameters
-    ----------
-    boundary : ContactBoundary
-    normal_law : a law of :mod:`adhesive_contact.laws`
-    beta : (nf,) the bonding β_n per contact facet
-    """
-
-    def __init__(self, boundary, normal_law, beta):
-        self.N = boundary.normal_trace
-        self.w = boundary.weights
-        self.law = normal_law
-        self.beta = boundary.at_points(beta)
-        self.active = normal_law.active
-
-    def value(self, z):
-        if not self.active:
-            return 0.0
-        return float(self.w @ self.law.potential(self.beta, self.N @ z))
-
-    def gradient(self, z):
-        if not self.active:
-            return np.zeros_like(z)
-        return self.N.T @ (self.w * self.law.value(self.beta, self.N @ z))
-
-    def hessian(self, z):
-        """An element of the generalised Hessian, sparse (nz, nz)."""
-        if not self.active:
-            return None
-        d = self.w * self.law.derivative(self.beta, self.N @ z)
-        return (self.N.T @ sp.diags(d) @ self.N).tocsr()
-
-    def normal_force(self, z):
-        """Σ_q w_q p_ν at each contact unknown (the compliance reaction)."""
-        return self.gradient(z)
 
 
 @dataclass
@@ -80,81 +51,145 @@ class StepResult:
     energy: float
     multiplier: np.ndarray = field(repr=False)   # wall reaction λ ≥ 0 per unknown
     on_wall: np.ndarray = field(repr=False)      # bool per unknown
+    stuck: np.ndarray = field(repr=False)        # bool per node with a kink (ξ_a = 0)
 
 
-def _newton_direction(H, g, free):
-    """Solve H_FF d = −g_F; a modified Cholesky (eigenvalue floor) if H_FF
-    is not positive definite."""
+@dataclass
+class Kink:
+    """The nodes whose friction has a kink: their tangential unknowns and κ_a."""
+
+    tangential: np.ndarray   # (na, m) indices into z
+    radius: np.ndarray       # (na,) κ_a ≥ 0
+
+
+def _solve_free(H, rhs, free):
+    """Solve H_FF d = rhs; a modified Cholesky (|eigenvalues|, floored) when
+    H_FF is not positive definite."""
     HF = H[np.ix_(free, free)]
     try:
-        return la.cho_solve(la.cho_factor(HF, check_finite=False), -g[free],
-                            check_finite=False)
+        return la.cho_solve(la.cho_factor(HF, check_finite=False), rhs, check_finite=False)
     except la.LinAlgError:
         vals, vecs = la.eigh(HF)
         floor = 1e-8 * max(np.abs(vals).max(), 1e-300)
-        return vecs @ ((vecs.T @ -g[free]) / np.maximum(np.abs(vals), floor))
+        return vecs @ ((vecs.T @ rhs) / np.maximum(np.abs(vals), floor))
 
 
-def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, sigma=1e-4):
-    """Minimise ½ zᵀSz − cᵀz + Φ(z) subject to z ≤ upper.
+def _blocks(v, idx):
+    return v[idx] if idx.size else np.zeros((0, 0))
+
+
+def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, sigma=1e-4):
+    """Minimise ½ zᵀSz − cᵀz + Φ(z) subject to z ≤ upper (see module doc).
 
     Parameters
     ----------
     S : (nz, nz) dense symmetric positive definite
     c : (nz,)
-    energy : ContactEnergy (value, gradient, hessian)
+    energy : ContactEnergy
     upper : (nz,) bounds, +inf where there is none
-    z0 : (nz,) initial guess (projected onto the bounds)
-    tol : relative tolerance on the projected gradient
+    z0 : (nz,) initial guess
+    tol : relative tolerance on the pseudo-gradient
+    kink : Kink or None
     """
-    z = np.minimum(z0, upper)
+    nz = c.size
     bounded = np.isfinite(upper)
+    if kink is None:
+        kink = Kink(np.zeros((0, 1), dtype=np.int64), np.zeros(0))
+    tan, kappa = kink.tangential, kink.radius
 
     def total(z):
         return 0.5 * z @ (S @ z) - c @ z + energy.value(z)
 
+    def noise(z):
+        # round-off of E: below it an energy comparison says nothing
+        return 1e-13 * (0.5 * abs(z @ (S @ z)) + abs(c @ z) + abs(energy.value(z)) + 1e-300)
+
+    z = np.minimum(z0, upper)
     E = total(z)
+    diag_S = np.maximum(np.diag(S), 1e-300) if nz else np.zeros(0)
     residual, scale = np.inf, 1.0
-    diag_S = np.maximum(np.diag(S), 1e-300) if S.size else np.zeros(0)
+    stuck = np.zeros(kappa.size, dtype=bool)
     for it in range(max_iter + 1):
         Sz = S @ z
         gphi = energy.gradient(z)
-        g = Sz - c + gphi
+        g = Sz - c + gphi                     # ∇E where E is differentiable
+        xi = _blocks(z, tan)
+        s = np.linalg.norm(xi, axis=1)
+        at_zero = s == 0
+        unit = np.where(at_zero[:, None], 0.0, xi / np.where(at_zero, 1.0, s)[:, None])
+        h = _blocks(g, tan) - kappa[:, None] * unit   # gradient without the kink
+        hn = np.linalg.norm(h, axis=1)
+
+        # pseudo-gradient: minimal-norm element of ∂E + N_wall
+        pg = g.copy()
+        wall = bounded & (z >= upper) & (g < 0)
+        pg[wall] = 0.0
+        if tan.size:
+            slide = np.where(hn > kappa, 1.0 - kappa / np.where(hn > 0, hn, 1.0), 0.0)
+            pg[tan[at_zero]] = (h * slide[:, None])[at_zero]
         scale = max(np.abs(c).max(initial=0.0), np.abs(Sz).max(initial=0.0),
-                    np.abs(gphi).max(initial=0.0), 1e-300)
-        # projected-gradient step length in displacement units
-        width = np.abs(z - np.minimum(z - g / diag_S, upper)).max(initial=0.0)
-        binding = bounded & (z >= upper - width) & (g < 0)
-        # only a coordinate exactly on the wall and pulled into it is stationary
-        pg = np.where(bounded & (z >= upper) & (g < 0), 0.0, g)
+                    np.abs(gphi).max(initial=0.0), kappa.max(initial=0.0), 1e-300)
         residual = np.abs(pg).max(initial=0.0)
         if residual <= tol * scale:
-            on_wall = bounded & (z >= upper) & (g < 0)
             return StepResult(z, True, "converged", it, residual / scale, tol, E,
-                              np.where(on_wall, -g, 0.0), on_wall)
+                              np.where(wall, -g, 0.0), wall, at_zero)
         if it == max_iter:
             break
+
+        # identify the sets with a projected-gradient step length ε
+        width = np.abs(z - np.minimum(z - pg / np.where(diag_S > 0, diag_S, 1.0),
+                                      upper)).max(initial=0.0)
+        binding = bounded & (z >= upper - width) & (g < 0)
+        stuck = (s <= width) & (hn <= kappa) if tan.size else stuck
+        fixed = binding.copy()
+        d = np.zeros(nz)
+        if tan.size:
+            fixed[tan[stuck]] = True
+            d[tan[stuck]] = -xi[stuck]
         H = S.copy()
-        Hphi = energy.hessian(z)
-        if Hphi is not None:
-            H += Hphi.toarray()
-        free = ~binding
-        d = np.zeros_like(z)
+        zmax = np.abs(z).max(initial=0.0)
+        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)
+        H += Hphi.toarray()
+        d[binding] = upper[binding] - z[binding]   # onto the wall
+        free = ~fixed
         if free.any():
-            d[free] = _newton_direction(H, g, free)
-        d[binding] = -g[binding] / np.diag(H)[binding]
-        alpha = 1.0
+            rhs = -pg[free] - H[np.ix_(free, fixed)] @ d[fixed]
+            d[free] = _solve_free(H, rhs, free)
+
+        # slipping directions held for this step
+        ref = unit.copy()
+        if tan.size:
+            start = at_zero & ~stuck
+            ref[start] = -pg[tan[start]] / np.maximum(
+                np.linalg.norm(pg[tan[start]], axis=1), 1e-300)[:, None]
+
+        def project(trial):
+            trial = np.minimum(trial, upper)
+            if tan.size:
+                txi = trial[tan]
+                turned = stuck | (np.sum(txi * ref, axis=1) <= 0)
+                txi[turned] = 0.0
+                trial[tan] = txi
+            return trial
+
+        def slope(step):
+            # E'(z; step): the kink adds κ |Δξ| at nodes where ξ = 0
+            out = g @ step
+            if tan.size:
+                out += kappa[at_zero] @ np.linalg.norm(step[tan[at_zero]], axis=1)
+            return out
+
+        alpha, slack = 1.0, noise(z)
         for _ in range(60):
-            trial = np.minimum(z + alpha * d, upper)
+            trial = project(z + alpha * d)
             E_trial = total(trial)
-            if E_trial <= E + sigma * (g @ (trial - z)):
+            if E_trial <= E + sigma * slope(trial - z) + slack:
                 break
             alpha *= 0.5
         else:
             return StepResult(z, False, "line search failed: no decrease of the energy "
                               "along the Newton direction", it, residual / scale, tol, E,
-                              np.zeros_like(z), np.zeros_like(z, dtype=bool))
+                              np.zeros(nz), np.zeros(nz, dtype=bool), stuck)
         z, E = trial, E_trial
     return StepResult(z, False, f"no convergence in {max_iter} iterations", max_iter,
-                      residual / scale, tol, E, np.zeros_like(z),
-                      np.zeros_like(z, dtype=bool))
+                      residual / scale, tol, E, np.zeros(nz), np.zeros(nz, dtype=bool), stuck)

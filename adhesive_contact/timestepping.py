@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .linear import CondensedOperator
-from .step_solver import ContactEnergy, minimise_step
+from .contact_energy import ContactEnergy
+from .step_solver import Kink, minimise_step
 
 
 class StepFailure(RuntimeError):
@@ -43,8 +44,9 @@ class Solution:
     beta: np.ndarray              # (N+1, nf) β per contact facet
     stress: np.ndarray            # (N+1, ncells, d, d) σ_n per cell
     contact_force: np.ndarray     # (N+1, nc, d) force of Γ_C on the body, nodal frames
-    normal_displacement: np.ndarray  # (N+1, nc) u_ν at the contact nodes
+    frame_displacement: np.ndarray  # (N+1, nc, d) [u_ν, u_τ] at the contact nodes
     on_wall: np.ndarray           # (N+1, nc) bool
+    stuck: np.ndarray             # (N+1, nc) bool: held at ξ = 0 by a friction kink
     probes: np.ndarray            # (N+1, nprobes, d)
     iterations: np.ndarray        # (N+1,) Newton iterations per step
     residual: np.ndarray          # (N+1,) final relative projected residual
@@ -53,6 +55,24 @@ class Solution:
     @property
     def steps(self):
         return self.t.size - 1
+
+    @property
+    def normal_displacement(self):
+        """u_ν at the contact nodes (N+1, nc)."""
+        return self.frame_displacement[:, :, 0]
+
+    def contact_states(self):
+        """Counts per level of contact nodes that are separated (u_ν < 0),
+        on the wall, stuck (ξ = 0 held by friction) and slipping (the rest
+        in contact with friction): a dict of (N+1,) int arrays."""
+        separated = self.normal_displacement < 0
+        touching = ~separated
+        out = {"separated": separated.sum(axis=1), "on_wall": self.on_wall.sum(axis=1)}
+        if self.problem.friction is not None:
+            moving = np.linalg.norm(self.frame_displacement[:, :, 1:], axis=2) > 0
+            out["stick"] = (touching & self.stuck).sum(axis=1)
+            out["slip"] = (touching & ~self.stuck & moving).sum(axis=1)
+        return out
 
     def total_normal_force(self):
         """Σ_a of the normal force Γ_C exerts, positive in compression (N+1,)."""
@@ -80,22 +100,21 @@ def solve(problem, progress=None):
     asm = problem.assembly
     free, d = problem.free, problem.dim
     N, k = scene.steps, scene.k
-    boundary = problem.boundary
-    memory = problem.memory
+    boundary, memory, bonding = problem.boundary, problem.memory, problem.bonding
     t_start = time.perf_counter()
+
+    # the system in nodal frames at Γ_C: ũ = Rᵀ u
+    R = boundary.rotation(asm.ndofs) if boundary is not None else None
+
+    def condensed(lam_, mu_):
+        A = asm.stiffness(lam_, mu_)
+        if R is not None:
+            A = (R.T @ A @ R).tocsr()
+        return CondensedOperator(A[free][:, free], problem.contact_positions)
 
     # the step matrices: A at t = 0, a_n = A + k R(0) for n >= 1
     lam, mu = scene.material.lam, scene.material.mu
     dlam, dmu = memory.instantaneous(k)
-    if boundary is not None:
-        contact, Q = problem.contact_positions, boundary.rotation()
-    else:
-        contact, Q = np.zeros(0, dtype=np.int64), None
-
-    def condensed(lam_, mu_):
-        A = asm.stiffness(lam_, mu_)[free][:, free]
-        return CondensedOperator(A, contact, Q)
-
     op0 = condensed(lam, mu)
     op = op0 if (dlam, dmu) == (0.0, 0.0) else condensed(lam + dlam, mu + dmu)
     t_factor = time.perf_counter() - t_start
@@ -108,37 +127,58 @@ def solve(problem, progress=None):
     beta = np.empty((N + 1, nf))
     stress = np.empty((N + 1, ncells, d, d))
     force = np.zeros((N + 1, nc, d))
-    un = np.zeros((N + 1, nc))
+    frame_u = np.zeros((N + 1, nc, d))
     wall = np.zeros((N + 1, nc), dtype=bool)
+    stuck = np.zeros((N + 1, nc), dtype=bool)
     probes = np.zeros((N + 1, nprobes, d))
     iterations = np.zeros(N + 1, dtype=int)
     residual = np.zeros(N + 1)
 
+    kink = None
+    if problem.friction is not None and problem.friction.has_kink:
+        tangential = np.arange(problem.columns.size).reshape(nc, d)[:, 1:]
+        kink = Kink(tangential, np.zeros(nc))
+    contact_dofs = None if boundary is None else boundary.dofs.ravel()
+
     memory.begin(k, asm.ndofs)
-    z = np.zeros(0 if boundary is None else boundary.n_unknowns)
-    beta_n = problem.beta0
+    z = np.zeros(problem.columns.size)
+    beta_n = problem.beta0.copy()
     t_loop = time.perf_counter()
     for n, t in enumerate(problem.times):
         step = op0 if n == 0 else op
+        if n >= 1 and bonding is not None:
+            # (4.2): β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1})
+            beta_n = beta_n + k * boundary.facet_mean(
+                bonding_rate(boundary, bonding, frame_u[n - 1].ravel(), beta_n))
         f = problem.loads(t)
         history = memory.history(n) if n >= 1 else None
         if history is not None:
             f -= asm.force(*history)
+        if R is not None:
+            f = R.T @ f
         b = f[free]
         c = step.reduce(b)
         if boundary is not None:
-            energy = ContactEnergy(boundary, problem.normal_law, beta_n)
+            energy = ContactEnergy(boundary, problem.columns, problem.normal_law,
+                                   problem.friction, beta_n)
+            if kink is not None:
+                kink.radius = energy.node_kink(boundary.point_node, nc)
             result = minimise_step(step.S, c, energy, problem.upper_bound(n), z,
-                                   scene.solver.tol, scene.solver.max_iter)
+                                   scene.solver.tol, scene.solver.max_iter, kink)
             if not result.success:
                 raise StepFailure(n, t, result)
             z = result.z
-            force[n] = (step.S @ z - c).reshape(nc, d)
-            un[n] = z[boundary.normal_unknowns]
-            wall[n] = result.on_wall[boundary.normal_unknowns]
+            # the force of Γ_C on the body: its reaction in the frame equations
+            force[n].reshape(-1)[problem.columns] = step.S @ z - c
+            wall[n] = result.on_wall[problem.normal_columns]
+            if kink is not None:
+                stuck[n] = result.stuck
             iterations[n], residual[n] = result.nit, result.residual
-        u = np.zeros(asm.ndofs)
-        u[free] = step.expand(z, b)
+        u_frame = np.zeros(asm.ndofs)
+        u_frame[free] = step.expand(z, b)
+        if boundary is not None:
+            frame_u[n] = u_frame[contact_dofs].reshape(nc, d)
+        u = R @ u_frame if R is not None else u_frame
         U[n] = u.reshape(npoints, d)
         beta[n] = beta_n
 
@@ -163,5 +203,14 @@ def solve(problem, progress=None):
         "stepping": t_end - t_loop,
         "total": problem.assembly_seconds + (t_end - t_start),
     }
-    return Solution(problem, problem.times.copy(), U, beta, stress, force, un, wall,
-                    probes, iterations, residual, timings)
+    return Solution(problem, problem.times.copy(), U, beta, stress, force, frame_u, wall,
+                    stuck, probes, iterations, residual, timings)
+
+
+def bonding_rate(boundary, bonding, z_full, beta):
+    """F(u_ν, u_τ, β) at the quadrature points of Γ_C, from the nodal-frame
+    components ``z_full`` (nc·d) of u and the facet values β."""
+    r = boundary.normal_trace @ z_full
+    xi = (np.stack([t @ z_full for t in boundary.tangential_trace], axis=-1)
+          if boundary.tangential_trace else None)
+    return bonding.rate(r, xi, boundary.at_points(beta))

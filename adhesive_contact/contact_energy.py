@@ -1,0 +1,94 @@
+"""The contact terms of a step as a function of the contact unknowns.
+
+    Φ(z) = Σ_q w_q [P_ν(β_q, (N z)_q) + j_τ(β_q, (T z)_q)]
+
+(MODEL.md §5), with N, T the traces of :mod:`adhesive_contact.contact_boundary`
+restricted to the unknowns the step solves for, β_q the P0 bonding of the
+facet holding q, and j_τ(β, ξ) = φ(β, |ξ|) radial (:mod:`adhesive_contact.laws`).
+
+``gradient`` is ∇Φ where Φ is differentiable; at ξ_q = 0 the friction part
+is left out (its Clarke subdifferential is the ball of radius
+w_q φ'(β_q, 0+), handled by the step solver through ``kink``).
+``hessian`` is an element of the generalised Hessian: for the friction at
+ξ ≠ 0, φ'' ξ̂ξ̂ᵀ + (φ'/|ξ|)(I − ξ̂ξ̂ᵀ); at ξ = 0, φ''(0+) I.
+"""
+
+import numpy as np
+import scipy.sparse as sp
+
+
+class ContactEnergy:
+    """Φ for one step: the laws, β_n and the traces on the step's unknowns.
+
+    Parameters
+    ----------
+    boundary : ContactBoundary
+    columns : (nz,) which of the full nodal-frame unknowns (nc·d, node-major)
+        the step solves for
+    normal_law, friction : laws (friction a FrictionSum or None)
+    beta : (nf,) β_n per contact facet
+    """
+
+    def __init__(self, boundary, columns, normal_law, friction, beta):
+        self.w = boundary.weights
+        self.N = boundary.normal_trace[:, columns].tocsr()
+        self.normal_law = normal_law
+        self.friction = friction
+        self.beta = boundary.at_points(beta)
+        self.T = ([t[:, columns].tocsr() for t in boundary.tangential_trace]
+                  if friction is not None else [])
+        self.nz = columns.size
+
+    def _xi(self, z):
+        return np.stack([t @ z for t in self.T], axis=-1)  # (nq, d−1)
+
+    def value(self, z):
+        out = 0.0
+        if self.normal_law.active:
+            out += self.w @ self.normal_law.potential(self.beta, self.N @ z)
+        if self.friction is not None:
+            out += self.w @ self.friction.potential(self.beta, self._xi(z))
+        return float(out)
+
+    def gradient(self, z):
+        g = np.zeros(self.nz)
+        if self.normal_law.active:
+            g += self.N.T @ (self.w * self.normal_law.value(self.beta, self.N @ z))
+        if self.friction is not None:
+            force = self.w[:, None] * self.friction.gradient(self.beta, self._xi(z))
+            for i, t in enumerate(self.T):
+                g += t.T @ force[:, i]
+        return g
+
+    def hessian(self, z, s_floor=0.0):
+        """Sparse (nz, nz); ``s_floor`` bounds |ξ| from below in φ''."""
+        H = sp.csr_matrix((self.nz, self.nz))
+        if self.normal_law.active:
+            d = self.w * self.normal_law.derivative(self.beta, self.N @ z)
+            H = H + self.N.T @ sp.diags(d) @ self.N
+        if self.friction is not None:
+            xi = self._xi(z)
+            s = np.linalg.norm(xi, axis=-1)
+            sf = np.maximum(s, s_floor)
+            dd = self.friction.ddphi(self.beta, sf)
+            m = len(self.T)
+            if m == 1:
+                blocks = dd[:, None, None] * np.ones((1, 1, 1))
+            else:
+                e = np.where(s[:, None] > 0, xi / np.where(s > 0, s, 1.0)[:, None], 0.0)
+                ee = e[:, :, None] * e[:, None, :]
+                tang = np.where(s > 0, self.friction.dphi(self.beta, sf) / sf, 0.0)
+                blocks = (dd[:, None, None] * np.where(s[:, None, None] > 0, ee, np.eye(m))
+                          + tang[:, None, None] * (np.eye(m) - ee))
+            for i, ti in enumerate(self.T):
+                for j, tj in enumerate(self.T):
+                    H = H + ti.T @ sp.diags(self.w * blocks[:, i, j]) @ tj
+        return H.tocsr()
+
+    def node_kink(self, nodes_of_points, n_nodes):
+        """κ_a = Σ_{q at a} w_q φ'(β_q, 0+) per contact node (nodal rule)."""
+        if self.friction is None:
+            return np.zeros(n_nodes)
+        keep = nodes_of_points >= 0   # clamped vertices carry no unknown
+        return np.bincount(nodes_of_points[keep],
+                           (self.w * self.friction.kink(self.beta))[keep], minlength=n_nodes)
