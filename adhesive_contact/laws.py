@@ -158,6 +158,11 @@ class SlipWeakening:
     def relaxation(self):
         return self.alpha * (self.a - self.b)
 
+    @property
+    def nonconvexity(self):
+        """−min φ'' = α (a − b): j_τ + ½ α (a−b) |ξ|² is convex."""
+        return self.alpha * (self.a - self.b)
+
     @staticmethod
     def check(params):
         if not params["a"] > params["b"]:
@@ -244,6 +249,11 @@ class FrictionSum:
     @property
     def relaxation(self):
         return sum(law.relaxation for law in self.laws)
+
+    @property
+    def nonconvexity(self):
+        """m with j_τ + ½ m |ξ|² convex (0 for convex potentials)."""
+        return sum(getattr(law, "nonconvexity", 0.0) for law in self.laws)
 
     @property
     def has_kink(self):

@@ -20,6 +20,7 @@ from .laws import make_bonding, make_friction, make_normal_law
 from .memory import make_memory
 from .mesh import build_mesh
 from .scene import SceneError
+from .smallness import smallness
 
 
 @dataclass
@@ -42,6 +43,25 @@ class Problem:
     probe_map: object         # sparse (nprobes, npoints) or None
     times: np.ndarray         # t_n, n = 0..N
     assembly_seconds: float
+    smallness: dict = None    # the terms of MODEL.md §2's condition (with contact)
+
+    def warnings(self):
+        """What the theory does not cover for this scene, one line each."""
+        out = []
+        s = self.smallness
+        if s is not None and not s["holds"]:
+            tail = ("the step energy is still strictly convex (m_A > m_c c_e²), so each "
+                    "step has one solution" if s["step_energy_convex"] else
+                    "the step energy may be nonconvex: the solver may fail or pick one of "
+                    "several solutions")
+            out.append(f"smallness condition of MODEL.md §2 does not hold: m_A = "
+                       f"{s['m_A']:.4g} <= (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}; uniqueness "
+                       f"is not guaranteed by the theory; {tail}")
+        if self.bonding is not None and self.scene.k > self.bonding.stable_step():
+            out.append(f"time step k = {self.scene.k:.4g} exceeds the explicit Euler bound "
+                       f"1/((gamma_nu + gamma_tau) L^2) = {self.bonding.stable_step():.4g} of "
+                       f"the bonding law: beta may overshoot below 0; use more steps")
+        return out
 
     @property
     def dim(self):
@@ -139,7 +159,9 @@ def build_problem(scene):
         probe_map = scalar.probes(points).tocsr()
 
     loads = LoadMap(mesh, scene.body, scene.traction)
+    normal_law = make_normal_law(scene.contact.normal)
+    small = smallness(scene, normal_law, friction) if boundary is not None else None
     return Problem(scene, mesh, assembly, free, clamped, boundary, columns, contact_positions,
-                   loads, gap, beta0, make_normal_law(scene.contact.normal), friction,
+                   loads, gap, beta0, normal_law, friction,
                    make_bonding(scene.contact.bonding), make_memory(scene.memory),
-                   probe_map, times, time.perf_counter() - t0)
+                   probe_map, times, time.perf_counter() - t0, small)

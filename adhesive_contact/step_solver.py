@@ -22,7 +22,9 @@ the orthant-wise treatment of the kink (as in OWL-QN):
   against ê_a is put to 0, so the sign of ξ/|ξ| cannot flip inside a step;
 - on the free coordinates a Newton step with H = S + ∂²Φ (a modified
   Cholesky when H is indefinite, e.g. under strong slip weakening),
-  coupled to the fixed coordinates' moves;
+  coupled to the fixed coordinates' moves; should its line search fail
+  (a nonconvex energy far from the solution), the scaled projected
+  gradient instead;
 - z(α) projected as above, α halved until
   E(z(α)) ≤ E(z) + σ E'(z; z(α) − z) (up to the round-off of E, so that
   the full step is taken once the decrease is below what E can resolve).
@@ -167,7 +169,7 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             trial = np.minimum(trial, upper)
             if tan.size:
                 txi = trial[tan]
-                turned = stuck | (np.sum(txi * ref, axis=1) <= 0)
+                turned = np.sum(txi * ref, axis=1) <= 0   # stuck nodes reach 0 at α = 1
                 txi[turned] = 0.0
                 trial[tan] = txi
             return trial
@@ -179,17 +181,29 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
                 out += kappa[at_zero] @ np.linalg.norm(step[tan[at_zero]], axis=1)
             return out
 
-        alpha, slack = 1.0, noise(z)
-        for _ in range(60):
-            trial = project(z + alpha * d)
-            E_trial = total(trial)
-            if E_trial <= E + sigma * slope(trial - z) + slack:
+        # the Newton direction, else (nonconvex energy, far from the
+        # solution) the scaled projected gradient, which always descends
+        slack = noise(z)
+        gradient_step = -pg / np.where(diag_S > 0, diag_S, 1.0)
+        if tan.size:
+            gradient_step[tan[stuck]] = -xi[stuck]
+        found = False
+        for direction in (d, gradient_step):
+            alpha = 1.0
+            for _ in range(60):
+                trial = project(z + alpha * direction)
+                E_trial = total(trial)
+                if E_trial <= E + sigma * slope(trial - z) + slack:
+                    found = True
+                    break
+                alpha *= 0.5
+            if found:
                 break
-            alpha *= 0.5
-        else:
+        if not found:
             return StepResult(z, False, "line search failed: no decrease of the energy "
-                              "along the Newton direction", it, residual / scale, tol, E,
-                              np.zeros(nz), np.zeros(nz, dtype=bool), stuck)
+                              "along the Newton or the gradient direction", it,
+                              residual / scale, tol, E, np.zeros(nz),
+                              np.zeros(nz, dtype=bool), stuck)
         z, E = trial, E_trial
     return StepResult(z, False, f"no convergence in {max_iter} iterations", max_iter,
                       residual / scale, tol, E, np.zeros(nz), np.zeros(nz, dtype=bool), stuck)
