@@ -1,0 +1,8 @@
+"""adhesive_contact_cli: the ``adhcontact`` command line (SPEC.md, "Command line").
+
+A thin layer over :mod:`adhesive_contact`: :mod:`.main` parses arguments,
+reads the scene, calls the library and reports errors in one line;
+:mod:`.postprocess` derives the reported quantities from a solution;
+:mod:`.output` writes the output folder (JSON, NPZ, XDMF) atomically and
+:mod:`.plots` draws its PNG figures.
+"""

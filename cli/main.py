@@ -1,0 +1,136 @@
+"""``adhcontact``: the click front end (SPEC.md, "Command line (firm)").
+
+Exit codes: 0 success; 2 a bad scene or bad arguments; 1 a solver that
+did not converge (or outputs that could not be written). Every error is
+one line ``error: ...`` on stderr, and nothing is written to the output
+folder: the scene is parsed, the problem built and the scheme run before
+any file is created, and the folder itself appears atomically.
+"""
+
+import sys
+from importlib import resources
+from pathlib import Path
+
+import click
+
+from adhesive_contact import SceneError, StepFailure, build_problem, parse_scene
+from adhesive_contact import solve as run_scheme
+
+from .output import write_outputs
+
+DEFAULT_SCENE = "default_scene.toml"
+
+
+class CliError(click.ClickException):
+    """An error reported as one line ``error: message`` with an exit code."""
+
+    def __init__(self, message, exit_code):
+        super().__init__(" ".join(str(message).split()))
+        self.exit_code = exit_code
+
+
+class OneLineGroup(click.Group):
+    """A click group whose errors (usage errors too) are one line on stderr."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
+             **extra):
+        """Run the group; in standalone mode report errors as one line and exit."""
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, False, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, False, **extra)
+        except getattr(click.exceptions, "NoArgsIsHelpError", ()) as err:
+            err.show()
+            sys.exit(err.exit_code)
+        except click.ClickException as err:
+            message = " ".join(err.format_message().split())
+            ctx = getattr(err, "ctx", None)
+            if isinstance(err, click.UsageError) and ctx is not None:
+                message += f" (see '{ctx.command_path} --help')"
+            click.echo(f"error: {message}", err=True)
+            sys.exit(err.exit_code)
+        except click.Abort:
+            click.echo("error: aborted", err=True)
+            sys.exit(1)
+        sys.exit(code if isinstance(code, int) else 0)
+
+
+def read_scene(path):
+    """The scene's name and TOML text: from ``path``, or the built-in default.
+
+    Raises :class:`CliError` (exit 2) when the file cannot be read."""
+    if path is None:
+        text = resources.files("adhesive_contact_cli").joinpath(DEFAULT_SCENE).read_text(
+            encoding="utf-8")
+        return "default", text
+    try:
+        return path.stem, path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise CliError(f"SCENE: no such file {str(path)!r}", 2) from None
+    except (OSError, UnicodeDecodeError) as err:
+        reason = err.strerror if isinstance(err, OSError) and err.strerror else err
+        raise CliError(f"SCENE: cannot read {str(path)!r}: {reason}", 2) from None
+
+
+def check_out(out):
+    """Refuse (exit 2) an ``--out`` that must not be replaced.
+
+    An existing folder is replaced only if it is empty or holds a previous
+    run's ``summary.json``: ``--out .`` or ``--out ~`` must not wipe a folder
+    of other files."""
+    if out.exists() and not out.is_dir():
+        raise CliError(f"--out: {str(out)!r} exists and is not a folder", 2)
+    if out.is_dir() and any(out.iterdir()) and not (out / "summary.json").is_file():
+        raise CliError(f"--out: {str(out)!r} is a non-empty folder that is not an "
+                       "adhcontact output (no summary.json); it would be replaced: "
+                       "choose another folder", 2)
+
+
+@click.group(cls=OneLineGroup)
+@click.version_option(package_name="adhesive_contact")
+def main():
+    """Quasistatic adhesive contact of a viscoelastic body with long memory."""
+
+
+@main.command()
+@click.argument("scene", required=False,
+                type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path),
+              help="Output folder (replaced if it exists). "
+                   "Default: ./<scene file stem>, ./default for the built-in scene.")
+def solve(scene, out):
+    """Run SCENE (a TOML file; the built-in default scene if omitted).
+
+    Writes summary.json, solution.npz, solution.xdmf/.h5 (ParaView) and PNG
+    plots into the output folder.
+    """
+    name, text = read_scene(scene)
+    try:
+        parsed = parse_scene(text)
+        problem = build_problem(parsed)
+    except SceneError as err:
+        raise CliError(str(err), 2) from None
+    out = Path(out) if out is not None else Path.cwd() / name
+    check_out(out)
+
+    with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
+                           file=sys.stderr) as bar:
+        try:
+            solution = run_scheme(problem, progress=lambda n, N: bar.update(1))
+        except StepFailure as err:
+            raise CliError(str(err), 1) from None
+    try:
+        files = write_outputs(solution, out)
+    except OSError as err:
+        raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+
+    mesh, boundary = problem.mesh, problem.boundary
+    contact = ("no contact boundary" if boundary is None else
+               f"{boundary.facets.size} contact facets, {boundary.nodes.size} contact nodes")
+    click.echo(f"{parsed.title}")
+    click.echo(f"  mesh: {mesh.p.shape[1]} nodes, {mesh.t.shape[1]} cells, "
+               f"{problem.ndofs} dofs ({problem.free.size} free), {contact}")
+    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}, "
+               f"{int(solution.iterations.sum())} solver iterations, "
+               f"{solution.timings['total']:.2f} s")
+    click.echo(f"  wrote {out}/: {', '.join(files)}")

@@ -1,0 +1,183 @@
+"""The output folder of ``adhcontact solve`` (SPEC.md, "Command line").
+
+:func:`write_outputs` writes every file into a temporary sibling folder
+``DIR.tmp-XXXX`` and then moves it into place, so a reader never sees a
+half-written ``DIR``:
+
+- ``summary.json``: resolved scene, mesh counts, timings, iterations and
+  one record per time level (:func:`~.postprocess.step_records`);
+- ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
+- ``solution.xdmf`` + ``solution.h5``: time series for ParaView with point
+  data u (3 components) and cell data stress (3×3 flattened) and von_mises
+  (without h5py installed, the data is written inline in the XDMF file and
+  there is no .h5);
+- ``contact.xdmf`` + ``contact.h5``: the contact facets with cell data beta
+  (only when the scene has a contact boundary);
+- PNG plots (:mod:`.plots`).
+"""
+
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+from . import plots
+from .postprocess import json_number, pad_tensors, pad_vectors, step_records, von_mises
+
+CELL_TYPES = {2: "triangle", 3: "tetra"}
+FACET_TYPES = {2: "line", 3: "triangle"}
+
+
+class _XdmfSeriesWriter(meshio.xdmf.TimeSeriesWriter):
+    """meshio's XDMF time-series writer with the HDF5 file beside the XDMF.
+
+    meshio 5.3 opens ``Path(filename).stem + ".h5"`` relative to the current
+    directory, not to the XDMF file; this writer opens it next to the XDMF
+    file (the XDMF refers to it by base name, as the reader expects)."""
+
+    def __enter__(self):
+        if self.data_format != "HDF":
+            return super().__enter__()
+        import h5py
+
+        self.h5_filename = str(self.filename.with_suffix(".h5"))
+        self.h5_file = h5py.File(self.h5_filename, "w")
+        return self
+
+
+def _data_format():
+    """"HDF" when h5py is installed (meshio needs it), else inline "XML"."""
+    try:
+        import h5py  # noqa: F401
+    except ImportError:
+        return "XML"
+    return "HDF"
+
+
+def summary(solution):
+    """The ``summary.json`` document (a dict of plain JSON types)."""
+    problem = solution.problem
+    mesh, boundary = problem.mesh, problem.boundary
+    return {
+        "scene": problem.scene.resolved,
+        "mesh": {
+            "nodes": int(mesh.p.shape[1]),
+            "cells": int(mesh.t.shape[1]),
+            "dofs": int(problem.ndofs),
+            "free_dofs": int(problem.free.size),
+            "contact_facets": 0 if boundary is None else int(boundary.facets.size),
+            "contact_nodes": 0 if boundary is None else int(boundary.nodes.size),
+        },
+        "timings": {key: json_number(value) for key, value in solution.timings.items()},
+        "iterations": [int(i) for i in solution.iterations],
+        "steps": step_records(solution),
+    }
+
+
+def write_summary(solution, path):
+    """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(summary(solution), f, indent=1, allow_nan=False)
+        f.write("\n")
+
+
+def contact_facets(problem):
+    """Node indices (nf, d) of the contact facets ((0, d) without Γ_C)."""
+    d = problem.mesh.dim()
+    if problem.boundary is None:
+        return np.zeros((0, d), dtype=np.int64)
+    return problem.boundary.facet_nodes.T.astype(np.int64)
+
+
+def write_npz(solution, path):
+    """Write ``solution.npz`` with exactly the firm keys of SPEC.md."""
+    problem = solution.problem
+    np.savez_compressed(
+        path,
+        points=problem.mesh.p.T,
+        cells=problem.mesh.t.T.astype(np.int64),
+        contact_facets=contact_facets(problem),
+        t=solution.t,
+        u=solution.u,
+        beta=solution.beta,
+    )
+
+
+def write_xdmf(solution, folder):
+    """Write the ParaView time series; return the names of the files written."""
+    problem = solution.problem
+    mesh = problem.mesh
+    d = mesh.dim()
+    points = mesh.p.T
+    fmt = _data_format()
+    h5 = fmt == "HDF"
+    names = ["solution.xdmf"] + ["solution.h5"] * h5
+    with _XdmfSeriesWriter(Path(folder) / names[0], fmt) as writer:
+        writer.write_points_cells(points, [(CELL_TYPES[d], mesh.t.T)])
+        for n, t in enumerate(solution.t):
+            writer.write_data(
+                float(t),
+                point_data={"u": pad_vectors(solution.u[n])},
+                cell_data={"stress": [pad_tensors(solution.stress[n])],
+                           "von_mises": [von_mises(solution.stress[n])]})
+    if problem.boundary is not None and problem.boundary.facets.size:
+        names += ["contact.xdmf"] + ["contact.h5"] * h5
+        with _XdmfSeriesWriter(Path(folder) / "contact.xdmf", fmt) as writer:
+            writer.write_points_cells(points, [(FACET_TYPES[d], contact_facets(problem))])
+            for n, t in enumerate(solution.t):
+                writer.write_data(float(t), point_data={"u": pad_vectors(solution.u[n])},
+                                  cell_data={"beta": [solution.beta[n]]})
+    return names
+
+
+def _replace_folder(new, target):
+    """Move folder ``new`` to ``target``, replacing an existing ``target``.
+
+    The old folder is renamed away first and deleted only once the new one
+    is in place (and renamed back if that fails)."""
+    if not target.exists():
+        os.rename(new, target)
+        return
+    graveyard = Path(tempfile.mkdtemp(prefix=f"{target.name}.old-", dir=target.parent))
+    old = graveyard / target.name
+    os.rename(target, old)
+    try:
+        os.rename(new, target)
+    except BaseException:
+        os.rename(old, target)
+        raise
+    shutil.rmtree(graveyard, ignore_errors=True)
+
+
+def write_outputs(solution, out):
+    """Write all outputs of a solve into folder ``out``, atomically.
+
+    Parameters
+    ----------
+    solution : adhesive_contact.Solution
+    out : path of the output folder; its parents are created, an existing
+        folder is replaced.
+
+    Returns
+    -------
+    list of str : the names of the files written, sorted.
+    """
+    out = Path(out).absolute()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-", dir=out.parent))
+    try:
+        write_summary(solution, tmp / "summary.json")
+        write_npz(solution, tmp / "solution.npz")
+        write_xdmf(solution, tmp)
+        plots.write_plots(solution, tmp)
+        os.chmod(tmp, 0o755)  # mkdtemp makes it private
+        names = sorted(p.name for p in tmp.iterdir())
+        _replace_folder(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return names

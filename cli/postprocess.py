@@ -1,0 +1,127 @@
+"""Quantities derived from a :class:`~adhesive_contact.Solution` for reports.
+
+Only post-processing lives here (no numerics of the scheme): von Mises
+stress, nodal contact tractions, facet means of β, padding to the three
+components ParaView expects, and the per-level records of ``summary.json``.
+"""
+
+import math
+
+import numpy as np
+
+
+def von_mises(stress):
+    """Von Mises equivalent stress of symmetric tensors.
+
+    Parameters
+    ----------
+    stress : (..., d, d) array, d = 2 or 3
+
+    Returns
+    -------
+    (...) array.
+        d = 3: sqrt(3/2 s:s) with s the deviator of σ.
+        d = 2: the plane-stress form sqrt(σxx² − σxx σyy + σyy² + 3 σxy²) of
+        the in-plane tensor. In plane strain σ_zz ≠ 0 but the solution does
+        not carry it (with memory it is not λ tr ε alone), so it is left out:
+        a plotting measure, not the full 3D invariant.
+    """
+    s = np.asarray(stress)
+    if s.shape[-1] == 2:
+        sxx, syy, sxy = s[..., 0, 0], s[..., 1, 1], s[..., 0, 1]
+        return np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2, 0.0))
+    dev = s - np.trace(s, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3.0
+    return np.sqrt(1.5 * np.einsum("...ij,...ij->...", dev, dev))
+
+
+def pad_vectors(v):
+    """Vectors (..., d) padded with zeros to (..., 3)."""
+    v = np.asarray(v, dtype=float)
+    pad = [(0, 0)] * (v.ndim - 1) + [(0, 3 - v.shape[-1])]
+    return np.pad(v, pad)
+
+
+def pad_tensors(t):
+    """Tensors (..., d, d) padded with zeros to 3×3 and flattened to (..., 9).
+
+    In 2D the zz component is 0 (see :func:`von_mises`)."""
+    t = np.asarray(t, dtype=float)
+    d = t.shape[-1]
+    pad = [(0, 0)] * (t.ndim - 2) + [(0, 3 - d), (0, 3 - d)]
+    padded = np.pad(t, pad)
+    return padded.reshape(*padded.shape[:-2], 9)
+
+
+def normal_traction(solution):
+    """Nodal normal traction on Γ_C, positive in compression, (N+1, nc).
+
+    The normal component of the nodal contact force divided by the lumped
+    nodal weight ∫_{Γ_C} φ_a, sign flipped (the force is negative in
+    compression)."""
+    boundary = solution.problem.boundary
+    return -solution.contact_force[:, :, 0] / boundary.node_weights
+
+
+def along_axis(points):
+    """The coordinate axis (0, 1, 2) along which points (d, n) spread most."""
+    points = np.asarray(points)
+    if points.shape[1] == 0:
+        return 0
+    return int(np.argmax(points.max(axis=1) - points.min(axis=1)))
+
+
+def facet_midpoints(problem):
+    """Midpoints (d, nf) of the contact facets."""
+    boundary = problem.boundary
+    return problem.mesh.p[:, boundary.facet_nodes].mean(axis=1)
+
+
+def beta_mean(solution):
+    """Facet-measure weighted mean of β per level (N+1,), or None (no facets)."""
+    boundary = solution.problem.boundary
+    if boundary is None or boundary.facets.size == 0:
+        return None
+    return solution.beta @ boundary.measure / boundary.measure.sum()
+
+
+def json_number(value):
+    """A finite float, or None for NaN and ±inf (JSON has neither)."""
+    value = float(value) + 0.0   # no -0.0
+    return value if math.isfinite(value) else None
+
+
+def _vector(values):
+    return [json_number(v) for v in np.ravel(values)]
+
+
+def step_records(solution):
+    """The per-level entries of ``summary.json``'s ``steps`` list.
+
+    Each is ``{"t", "probes", "normal_force", "tangential_force", "beta_mean",
+    "beta_min", "n_wall", "max_penetration", "iterations", "residual"}``:
+    tangential_force is a number in 2D and a list of d − 1 in 3D; beta_mean
+    and beta_min are None without contact facets; max_penetration is
+    max_a (u_ν − g), None without a wall.
+    """
+    d = solution.u.shape[2]
+    normal = solution.total_normal_force()
+    tangential = solution.total_tangential_force()
+    means = beta_mean(solution)
+    violation = solution.gap_violation()
+    records = []
+    for n, t in enumerate(solution.t):
+        has_beta = solution.beta.shape[1] > 0
+        records.append({
+            "t": json_number(t),
+            "probes": [_vector(p) for p in solution.probes[n]],
+            "normal_force": json_number(normal[n]),
+            "tangential_force": (json_number(tangential[n, 0]) if d == 2
+                                 else _vector(tangential[n])),
+            "beta_mean": None if means is None else json_number(means[n]),
+            "beta_min": json_number(solution.beta[n].min()) if has_beta else None,
+            "n_wall": int(solution.on_wall[n].sum()),
+            "max_penetration": json_number(violation[n]),
+            "iterations": int(solution.iterations[n]),
+            "residual": json_number(solution.residual[n]),
+        })
+    return records

@@ -1,0 +1,390 @@
+"""Tests for the ``adhcontact`` command line (SPEC.md, "Command line (firm)")."""
+
+import inspect
+import json
+import tomllib
+from importlib import resources
+
+import meshio
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from adhesive_contact_cli.main import main
+
+# an 8x4 block hanging from its top, pulled down onto a wall with a gap that
+# is smallest in the middle: the wall becomes active at step 1 (7 nodes)
+SCENE = """\
+title = "test block"
+dim = 2
+
+[mesh]
+domain = "rectangle"
+size = [2.0, 1.0]
+cells = [8, 4]
+
+[boundary]
+dirichlet = ["top"]
+contact = ["bottom"]
+
+[material]
+E = 1000.0
+nu = 0.3
+
+[memory]
+kernel = "prony"
+terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
+
+[loads]
+body = ["0", "-400*t"]
+
+[contact]
+gap = "0.002 + 0.01*(x - 1)**2"
+
+[contact.normal]
+law = "compliance"
+c = 5000.0
+
+[time]
+T = 1.0
+steps = 3
+
+[output]
+probes = [[1.0, 0.0], [0.0, 0.5]]
+"""
+
+NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
+STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
+             "n_wall", "max_penetration", "iterations", "residual"}
+FILES = {"summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
+         "contact.h5", "deformed.png", "contact_traction.png", "beta.png"}
+
+
+def edit(text, old, new):
+    """``text`` with its one occurrence of ``old`` replaced by ``new``."""
+    assert text.count(old) == 1, old
+    return text.replace(old, new)
+
+
+def runner():
+    """A CliRunner keeping stderr apart (click >= 8.2 always does)."""
+    if "mix_stderr" in inspect.signature(CliRunner).parameters:
+        return CliRunner(mix_stderr=False)
+    return CliRunner()
+
+
+def run(*args):
+    return runner().invoke(main, list(map(str, args)), catch_exceptions=False)
+
+
+def strict_json(path):
+    """Load JSON, failing on NaN or Infinity (not JSON)."""
+    def refuse(name):
+        raise ValueError(f"{name} in {path}")
+    return json.loads(path.read_text(), parse_constant=refuse)
+
+
+@pytest.fixture(scope="module")
+def solved(tmp_path_factory):
+    """The small scene solved once; returns (result, out folder, its parent)."""
+    root = tmp_path_factory.mktemp("solve")
+    scene = root / "scene.toml"
+    scene.write_text(SCENE)
+    out = root / "results" / "run"   # parents are created
+    result = run("solve", scene, "--out", out)
+    return result, out, root
+
+
+def test_solve_writes_every_output(solved):
+    result, out, root = solved
+    assert result.exit_code == 0, result.stderr
+    assert set(p.name for p in out.iterdir()) == FILES
+    # no temporary folders left beside the output
+    assert [p.name for p in out.parent.iterdir()] == ["run"]
+    assert str(out) in result.stdout
+    assert "45 nodes, 64 cells" in result.stdout
+
+
+def test_npz_has_the_firm_keys_and_shapes(solved):
+    _, out, _ = solved
+    with np.load(out / "solution.npz") as data:
+        assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta"}
+        assert data["points"].shape == (NPOINTS, 2)
+        assert data["cells"].shape == (NCELLS, 3)
+        assert data["contact_facets"].shape == (NFACETS, 2)
+        assert data["t"].shape == (NLEVELS,)
+        assert data["u"].shape == (NLEVELS, NPOINTS, 2)
+        assert data["beta"].shape == (NLEVELS, NFACETS)
+        assert np.issubdtype(data["cells"].dtype, np.integer)
+        assert np.issubdtype(data["contact_facets"].dtype, np.integer)
+        np.testing.assert_allclose(data["t"], [0, 1 / 3, 2 / 3, 1])
+        # the contact facets are the bottom edges
+        assert np.all(data["points"][data["contact_facets"], 1] == 0.0)
+        top = data["points"][:, 1] == 1.0
+        assert np.all(data["u"][:, top] == 0.0)
+        assert np.abs(data["u"][-1]).max() > 0
+
+
+def test_summary_has_one_record_per_level(solved):
+    _, out, _ = solved
+    summary = strict_json(out / "summary.json")
+    assert set(summary) == {"scene", "mesh", "timings", "iterations", "steps"}
+    assert summary["scene"]["title"] == "test block"
+    assert summary["scene"]["time"]["steps"] == 3
+    assert summary["mesh"] == {"nodes": NPOINTS, "cells": NCELLS, "dofs": 2 * NPOINTS,
+                               "free_dofs": 2 * NPOINTS - 18, "contact_facets": NFACETS,
+                               "contact_nodes": 9}
+    assert {"assembly", "factorisation", "stepping", "total"} <= set(summary["timings"])
+    assert len(summary["iterations"]) == NLEVELS
+    steps = summary["steps"]
+    assert len(steps) == NLEVELS
+    for n, step in enumerate(steps):
+        assert set(step) == STEP_KEYS
+        assert step["t"] == pytest.approx(n / 3)
+        assert np.shape(step["probes"]) == (2, 2)
+        assert isinstance(step["tangential_force"], float)
+        assert step["iterations"] == summary["iterations"][n]
+        assert step["beta_mean"] == pytest.approx(1.0)   # no bonding law: β = β_0 = 1
+        assert step["beta_min"] == pytest.approx(1.0)
+    assert steps[0]["n_wall"] == 0
+    assert steps[0]["normal_force"] == pytest.approx(0.0)
+    assert steps[0]["max_penetration"] == pytest.approx(-0.002)   # min gap, at x = 1
+    assert steps[-1]["n_wall"] > 0
+    assert steps[-1]["normal_force"] > steps[1]["normal_force"] > 0
+    assert abs(steps[-1]["max_penetration"]) < 1e-9                # on the wall, not through it
+    with np.load(out / "solution.npz") as data:
+        node = np.flatnonzero(np.all(data["points"] == [1.0, 0.0], axis=1))[0]
+        np.testing.assert_allclose(steps[-1]["probes"][0], data["u"][-1, node], atol=1e-12)
+
+
+def test_xdmf_reads_back_as_a_time_series(solved):
+    _, out, _ = solved
+    with np.load(out / "solution.npz") as data:
+        u, points = data["u"], data["points"]
+    reader = meshio.xdmf.TimeSeriesReader(out / "solution.xdmf")
+    pts, cells = reader.read_points_cells()
+    np.testing.assert_allclose(pts[:, :2], points)
+    assert cells[0].type == "triangle" and cells[0].data.shape == (NCELLS, 3)
+    assert reader.num_steps == NLEVELS
+    t, point_data, cell_data = reader.read_data(NLEVELS - 1)
+    assert t == pytest.approx(1.0)
+    assert point_data["u"].shape == (NPOINTS, 3)
+    np.testing.assert_allclose(point_data["u"][:, :2], u[-1])
+    assert np.all(point_data["u"][:, 2] == 0.0)
+    assert cell_data["stress"][0].shape == (NCELLS, 9)
+    assert cell_data["von_mises"][0].shape == (NCELLS,)
+    assert np.all(cell_data["von_mises"][0] >= 0) and cell_data["von_mises"][0].max() > 0
+
+    contact = meshio.xdmf.TimeSeriesReader(out / "contact.xdmf")
+    _, facet_cells = contact.read_points_cells()
+    assert facet_cells[0].type == "line" and facet_cells[0].data.shape == (NFACETS, 2)
+    assert contact.num_steps == NLEVELS
+    assert contact.read_data(0)[2]["beta"][0].shape == (NFACETS,)
+
+
+def test_hdf5_files_are_not_written_to_the_working_directory(tmp_path, monkeypatch):
+    """meshio 5.3 puts the .h5 in the current directory; ours go beside the .xdmf."""
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    (tmp_path / "scene.toml").write_text(SCENE)
+    result = run("solve", tmp_path / "scene.toml", "--out", tmp_path / "out")
+    assert result.exit_code == 0, result.stderr
+    assert list(work.iterdir()) == []
+    assert (tmp_path / "out" / "solution.h5").stat().st_size > 0
+
+
+def test_pngs_are_images(solved):
+    _, out, _ = solved
+    for name in ("deformed.png", "contact_traction.png", "beta.png"):
+        data = (out / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n", name
+        assert len(data) > 10_000, name
+
+
+def test_default_out_is_named_after_the_scene(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "wall_case.toml").write_text(SCENE)
+    result = run("solve", "wall_case.toml")
+    assert result.exit_code == 0, result.stderr
+    assert set(p.name for p in (tmp_path / "wall_case").iterdir()) == FILES
+
+
+def test_existing_out_is_replaced(tmp_path):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text("{}")   # a previous run's output
+    (out / "stale.txt").write_text("old")
+    result = run("solve", tmp_path / "scene.toml", "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert set(p.name for p in out.iterdir()) == FILES
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "scene.toml"]
+
+
+def test_out_folder_of_other_files_is_not_replaced(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scene.toml").write_text(SCENE)
+    result = run("solve", "scene.toml", "--out", ".")
+    assert_one_line_error(result, 2, "--out")
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
+
+
+def test_default_scene_runs_without_arguments(tmp_path):
+    out = tmp_path / "default_out"
+    result = run("solve", "--out", out)
+    assert result.exit_code == 0, result.stderr
+    text = resources.files("adhesive_contact_cli").joinpath("default_scene.toml").read_text()
+    steps = tomllib.loads(text)["time"]["steps"]
+    summary = strict_json(out / "summary.json")
+    assert len(summary["steps"]) == steps + 1
+    assert {"summary.json", "solution.npz", "solution.xdmf", "deformed.png"} <= set(
+        p.name for p in out.iterdir())
+
+
+def test_default_scene_default_out_is_default(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = run("solve")
+    assert result.exit_code == 0, result.stderr
+    assert (tmp_path / "default" / "summary.json").is_file()
+
+
+def test_scene_without_contact_skips_contact_outputs(tmp_path):
+    text = edit(SCENE, 'contact = ["bottom"]\n', "")
+    text = text[:text.index("[contact]")] + text[text.index("[time]"):]
+    (tmp_path / "scene.toml").write_text(text)
+    out = tmp_path / "out"
+    result = run("solve", tmp_path / "scene.toml", "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert set(p.name for p in out.iterdir()) == FILES - {
+        "contact.xdmf", "contact.h5", "contact_traction.png", "beta.png"}
+    summary = strict_json(out / "summary.json")
+    assert summary["mesh"]["contact_facets"] == 0
+    last = summary["steps"][-1]
+    assert last["beta_mean"] is None and last["beta_min"] is None
+    assert last["max_penetration"] is None and last["n_wall"] == 0
+    with np.load(out / "solution.npz") as data:
+        assert data["contact_facets"].shape == (0, 2)
+        assert data["beta"].shape == (NLEVELS, 0)
+
+
+def test_solve_in_3d(tmp_path):
+    text = SCENE.replace('dim = 2', 'dim = 3').replace('"rectangle"', '"box"')
+    text = text.replace("size = [2.0, 1.0]", "size = [2.0, 1.0, 1.0]")
+    text = text.replace("cells = [8, 4]", "cells = [2, 2, 2]")
+    text = text.replace('body = ["0", "-400*t"]', 'body = ["0", "-400*t", "0"]')
+    text = text.replace("probes = [[1.0, 0.0], [0.0, 0.5]]", "probes = [[1.0, 0.0, 0.5]]")
+    (tmp_path / "scene.toml").write_text(text)
+    out = tmp_path / "out"
+    result = run("solve", tmp_path / "scene.toml", "--out", out)
+    assert result.exit_code == 0, result.stderr
+    with np.load(out / "solution.npz") as data:
+        npoints, nf = data["points"].shape[0], data["contact_facets"].shape[0]
+        assert data["points"].shape == (27, 3)
+        assert data["cells"].shape[1] == 4
+        assert data["contact_facets"].shape == (nf, 3) and nf > 0
+        assert data["u"].shape == (NLEVELS, npoints, 3)
+        assert data["beta"].shape == (NLEVELS, nf)
+    step = strict_json(out / "summary.json")["steps"][-1]
+    assert np.shape(step["probes"]) == (1, 3)
+    assert isinstance(step["tangential_force"], list) and len(step["tangential_force"]) == 2
+    assert (out / "deformed.png").stat().st_size > 0
+
+
+BAD_SCENES = [
+    # (id, old text, new text, what the message must contain)
+    ("unknown key", "size = [2.0, 1.0]\n", "size = [2.0, 1.0]\nsise = [2.0, 1.0]\n",
+     "mesh.sise"),
+    ("cells 0", "cells = [8, 4]", "cells = [0, 8]", "mesh.cells"),
+    ("missing E", "E = 1000.0\n", "", "material.E"),
+    ("steps not int", "steps = 3", 'steps = "ten"', "time.steps"),
+    ("E zero", "E = 1000.0", "E = 0.0", "material.E"),
+    ("E negative", "E = 1000.0", "E = -5.0", "material.E"),
+    ("nu 0.5", "nu = 0.3\n\n[memory]", "nu = 0.5\n\n[memory]", "material.nu"),
+    ("T zero", "T = 1.0", "T = 0.0", "time.T"),
+    ("T negative", "T = 1.0", "T = -1.0", "time.T"),
+    ("steps zero", "steps = 3", "steps = 0", "time.steps"),
+    ("prony tau", "tau = 0.5", "tau = 0.0", "memory.terms[0].tau"),
+    ("unknown side", 'dirichlet = ["top"]', 'dirichlet = ["middle"]', "boundary.dirichlet"),
+    ("disallowed name", 'body = ["0", "-400*t"]', """body = ["0", "__import__('os')"]""",
+     "loads.body[1]"),
+    ("attribute access", 'body = ["0", "-400*t"]', 'body = ["0", "t.real"]', "loads.body[1]"),
+    ("probe outside", "probes = [[1.0, 0.0], [0.0, 0.5]]", "probes = [[1.0, 0.0], [5.0, 0.5]]",
+     "output.probes[1]"),
+    ("negative gap", 'gap = "0.002 + 0.01*(x - 1)**2"', 'gap = "0.002 - 0.01*x"', "contact.gap"),
+    ("invalid TOML", "dim = 2", "dim = = 2", "TOML"),
+]
+
+
+def assert_one_line_error(result, code, needle):
+    assert result.exit_code == code, (result.stdout, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("error: "), lines[0]
+    assert needle in lines[0], lines[0]
+    assert "Traceback" not in result.stderr + result.stdout
+
+
+@pytest.mark.parametrize("old, new, key", [case[1:] for case in BAD_SCENES],
+                         ids=[case[0] for case in BAD_SCENES])
+def test_bad_scene_exits_2_with_one_line_naming_the_key(tmp_path, old, new, key):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(edit(SCENE, old, new))
+    result = run("solve", scene, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, key)
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written
+
+
+def test_missing_scene_file_exits_2(tmp_path):
+    result = run("solve", tmp_path / "nowhere.toml", "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "nowhere.toml")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_scene_that_is_a_folder_exits_2(tmp_path):
+    result = run("solve", tmp_path, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "is a directory")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["solve", "--outt", "x"], "--outt"),
+    (["solve", "a.toml", "b.toml"], "b.toml"),
+    (["solve", "--out"], "--out"),
+    (["unknown-command"], "unknown-command"),
+])
+def test_bad_arguments_exit_2_with_one_line(tmp_path, monkeypatch, args, needle):
+    monkeypatch.chdir(tmp_path)
+    result = run(*args)
+    assert_one_line_error(result, 2, needle)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_out_that_is_a_file_exits_2(tmp_path):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    (tmp_path / "out").write_text("a file")
+    result = run("solve", tmp_path / "scene.toml", "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "--out")
+    assert (tmp_path / "out").read_text() == "a file"
+
+
+def test_solver_failure_exits_1_and_writes_nothing(tmp_path):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(edit(SCENE, "[output]", "[solver]\nmax_iter = 1\n\n[output]"))
+    result = run("solve", scene, "--out", tmp_path / "out")
+    assert result.exit_code == 1, (result.stdout, result.stderr)
+    errors = [line for line in result.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1, result.stderr
+    assert "did not converge" in errors[0] and "step 1" in errors[0]
+    assert "Traceback" not in result.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
+
+
+def test_the_failing_scene_converges_with_more_iterations(tmp_path):
+    """The failure above is the iteration cap: with it lifted the wall is active."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(edit(SCENE, "[output]", "[solver]\nmax_iter = 50\n\n[output]"))
+    result = run("solve", scene, "--out", tmp_path / "out")
+    assert result.exit_code == 0, result.stderr
+    steps = strict_json(tmp_path / "out" / "summary.json")["steps"]
+    assert steps[1]["n_wall"] > 0 and steps[1]["iterations"] > 1
