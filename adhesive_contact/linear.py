@@ -25,8 +25,9 @@ class DirectSolver:
 
     def __init__(self, A):
         self.n = A.shape[0]
-        self.lu = splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A",
-                       options={"SymmetricMode": True}) if self.n else None
+        # minimum degree on Aᵀ + A; SuperLU's SymmetricMode made the
+        # factorisation 3× slower here (studies/README.md, linear algebra)
+        self.lu = splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A") if self.n else None
 
     def solve(self, b):
         if self.n == 0:
@@ -44,10 +45,11 @@ class CondensedOperator:
     contact : (nC,) int
         Positions, within the free dofs, of the contact unknowns.
     chunk : int
-        Right-hand sides per block solve when forming S.
+        Right-hand sides per block solve when forming S (SuperLU's block
+        solve is fastest per column for a few columns at a time).
     """
 
-    def __init__(self, A, contact, chunk=128):
+    def __init__(self, A, contact, chunk=4):
         t0 = time.perf_counter()
         n = A.shape[0]
         self.contact = np.asarray(contact, dtype=np.int64)
@@ -66,7 +68,7 @@ class CondensedOperator:
         S = A[self.contact][:, self.contact].toarray()
         for start in range(0, nC, chunk):
             cols = slice(start, min(start + chunk, nC))
-            X = self.solver.solve(self.A_IC[:, cols].toarray())
+            X = self.solver.solve(np.asfortranarray(self.A_IC[:, cols].toarray()))
             S[:, cols] -= self.A_CI @ X
         self.S = 0.5 * (S + S.T)
         self.schur_seconds = time.perf_counter() - t0

@@ -43,6 +43,7 @@ class Solution:
     u: np.ndarray                 # (N+1, npoints, d)
     beta: np.ndarray              # (N+1, nf) β per contact facet
     stress: np.ndarray            # (N+1, ncells, d, d) σ_n per cell
+    stress_zz: np.ndarray         # (N+1, ncells) plane strain σ_zz (2D), or None
     contact_force: np.ndarray     # (N+1, nc, d) force of Γ_C on the body, nodal frames
     frame_displacement: np.ndarray  # (N+1, nc, d) [u_ν, u_τ] at the contact nodes
     on_wall: np.ndarray           # (N+1, nc) bool
@@ -126,6 +127,7 @@ def solve(problem, progress=None):
     U = np.zeros((N + 1, npoints, d))
     beta = np.empty((N + 1, nf))
     stress = np.empty((N + 1, ncells, d, d))
+    stress_zz = np.empty((N + 1, ncells)) if d == 2 else None
     force = np.zeros((N + 1, nc, d))
     frame_u = np.zeros((N + 1, nc, d))
     wall = np.zeros((N + 1, nc), dtype=bool)
@@ -188,6 +190,9 @@ def solve(problem, progress=None):
         if history is not None:
             a_lam, a_mu = a_lam + history[0], a_mu + history[1]
         stress[n] = asm.cell_stress(a_lam, a_mu)
+        if stress_zz is not None:
+            # ε_zz = 0 in plane strain: σ_zz = λ tr ε (+ the memory's λ parts)
+            stress_zz[n] = np.trace(asm.cell_strain(a_lam), axis1=1, axis2=2)
         if nprobes:
             probes[n] = problem.probe_map @ U[n]
         if n >= 1:
@@ -203,7 +208,7 @@ def solve(problem, progress=None):
         "stepping": t_end - t_loop,
         "total": problem.assembly_seconds + (t_end - t_start),
     }
-    return Solution(problem, problem.times.copy(), U, beta, stress, force, frame_u, wall,
+    return Solution(problem, problem.times.copy(), U, beta, stress, stress_zz, force, frame_u, wall,
                     stuck, probes, iterations, residual, timings)
 
 
