@@ -92,7 +92,13 @@ class AdhesiveCompliance:
     Compression pushes back with stiffness c; a bonded, separated surface
     is pulled back by the glue up to a separation L. The potential is
     P_ν = c r_+²/2 + γ β² Ψ(r) with Ψ(r) = r²/2 on [−L, 0], 0 for r > 0
-    and −L r − L²/2 for r < −L (Ψ' = −R_ν). m_ν = max(c + γ, 2 γ L).
+    and −L r − L²/2 for r < −L (Ψ' = −R_ν).
+
+    m_ν = max(c, γ, 2 γ L): the slopes in r (c, or γβ² ≤ γ) and in β
+    (2 γ β R_ν ≤ 2 γ L) never act together, so this is the sharp constant
+    for |Δp| ≤ m_ν (|Δβ| + |Δr|), β ∈ [0, 1]. MODEL.md §6 quotes the valid
+    but looser max(c + γ, 2 γ L); the sharper one keeps the smallness
+    estimate of :mod:`adhesive_contact.smallness` less conservative.
     """
 
     c: float
@@ -103,7 +109,7 @@ class AdhesiveCompliance:
 
     @property
     def lipschitz(self):
-        return max(self.c + self.gamma, 2.0 * self.gamma * self.L)
+        return max(self.c, self.gamma, 2.0 * self.gamma * self.L)
 
     def potential(self, beta, r):
         rp = np.maximum(r, 0.0)
@@ -131,13 +137,13 @@ class Tresca:
     relaxation = 0.0
 
     def kink(self, beta):
-        return np.full_like(beta, self.mu)
+        return np.full(np.shape(beta), float(self.mu))
 
     def phi(self, beta, s):
         return self.mu * s
 
     def dphi(self, beta, s):
-        return np.full_like(s, self.mu)
+        return np.full(np.shape(s), float(self.mu))
 
     def ddphi(self, beta, s):
         return np.zeros_like(s)
@@ -170,7 +176,7 @@ class SlipWeakening:
         return None
 
     def kink(self, beta):
-        return np.full_like(beta, self.a)
+        return np.full(np.shape(beta), float(self.a))
 
     def phi(self, beta, s):
         return self.b * s + (self.a - self.b) * (-np.expm1(-self.alpha * s)) / self.alpha
@@ -309,10 +315,11 @@ class Fremond:
     def stretch(self, r, xi):
         """γ_ν R_ν(r)² + γ_τ |R_τ(ξ)|², bounded by (γ_ν + γ_τ) L²."""
         rn = separation(r, self.L)
-        out = self.gamma_nu * rn * rn
+        out = self.gamma_nu * (rn * rn)
         if xi is not None and self.gamma_tau:
             rt = truncate(xi, self.L)
-            out = out + self.gamma_tau * np.sum(rt * rt, axis=-1)
+            # |R_τ|² ≤ L² also in floating point, so k = stable_step() is safe
+            out = out + self.gamma_tau * np.minimum(np.sum(rt * rt, axis=-1), self.L * self.L)
         return out
 
     def rate(self, r, xi, beta):
@@ -323,7 +330,7 @@ class Fremond:
     def stable_step(self):
         """The largest k with β_n ≥ 0 guaranteed for explicit Euler:
         k (γ_ν + γ_τ) L² ≤ 1 (β_n ≥ β_{n−1}(1 − k max stretch))."""
-        worst = (self.gamma_nu + self.gamma_tau) * self.L ** 2
+        worst = self.gamma_nu * (self.L * self.L) + self.gamma_tau * (self.L * self.L)
         return np.inf if worst == 0 else 1.0 / worst
 
 
