@@ -4,7 +4,10 @@ Exit codes: 0 success; 2 a bad scene or bad arguments; 1 a solver that
 did not converge (or outputs that could not be written). Every error is
 one line ``error: ...`` on stderr, and nothing is written to the output
 folder: the scene is parsed, the problem built and the scheme run before
-any file is created, and the folder itself appears atomically.
+any file is created, and the folder itself appears atomically. What the
+theory does not cover for a valid scene (``Problem.warnings()``) is
+reported as one line ``warning: ...`` each on stderr before the time loop,
+and the run goes on.
 """
 
 import sys
@@ -17,6 +20,7 @@ from adhesive_contact import SceneError, StepFailure, build_problem, parse_scene
 from adhesive_contact import solve as run_scheme
 
 from .output import write_outputs
+from .postprocess import beta_mean
 
 DEFAULT_SCENE = "default_scene.toml"
 
@@ -112,6 +116,8 @@ def solve(scene, out):
         raise CliError(str(err), 2) from None
     out = Path(out) if out is not None else Path.cwd() / name
     check_out(out)
+    for warning in problem.warnings():
+        click.echo(f"warning: {' '.join(str(warning).split())}", err=True)
 
     with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
                            file=sys.stderr) as bar:
@@ -133,4 +139,11 @@ def solve(scene, out):
     click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}, "
                f"{int(solution.iterations.sum())} solver iterations, "
                f"{solution.timings['total']:.2f} s")
+    if boundary is not None and boundary.facets.size:
+        states = {key: int(value[-1]) for key, value in solution.contact_states().items()}
+        friction = (f", stick {states['stick']}, slip {states['slip']}"
+                    if "stick" in states else "")
+        click.echo(f"  Γ_C at t = {parsed.T:g}: β mean {beta_mean(solution)[-1]:.4g}, "
+                   f"min {solution.beta[-1].min():.4g}; contact nodes separated "
+                   f"{states['separated']}, on the wall {states['on_wall']}{friction}")
     click.echo(f"  wrote {out}/: {', '.join(files)}")

@@ -4,15 +4,17 @@
 ``DIR.tmp-XXXX`` and then moves it into place, so a reader never sees a
 half-written ``DIR``:
 
-- ``summary.json``: resolved scene, mesh counts, timings, iterations and
-  one record per time level (:func:`~.postprocess.step_records`);
+- ``summary.json``: resolved scene, mesh counts, the smallness terms of
+  MODEL.md §2 (null without contact), the warnings of the problem, timings,
+  iterations and one record per time level (:func:`~.postprocess.step_records`);
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
 - ``solution.xdmf`` + ``solution.h5``: time series for ParaView with point
   data u (3 components) and cell data stress (3×3 flattened) and von_mises
   (without h5py installed, the data is written inline in the XDMF file and
   there is no .h5);
 - ``contact.xdmf`` + ``contact.h5``: the contact facets with cell data beta
-  (only when the scene has a contact boundary);
+  and point data u, one record per time level (only when the scene has
+  contact facets);
 - PNG plots (:mod:`.plots`).
 """
 
@@ -26,7 +28,8 @@ import meshio
 import numpy as np
 
 from . import plots
-from .postprocess import json_number, pad_tensors, pad_vectors, step_records, von_mises
+from .postprocess import (json_number, pad_tensors, pad_vectors, smallness_record,
+                          step_records, von_mises)
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 FACET_TYPES = {2: "line", 3: "triangle"}
@@ -72,6 +75,8 @@ def summary(solution):
             "contact_facets": 0 if boundary is None else int(boundary.facets.size),
             "contact_nodes": 0 if boundary is None else int(boundary.nodes.size),
         },
+        "smallness": smallness_record(problem),
+        "warnings": [str(w) for w in problem.warnings()],
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "iterations": [int(i) for i in solution.iterations],
         "steps": step_records(solution),

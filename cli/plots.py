@@ -17,7 +17,7 @@ from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 
 from .postprocess import (along_axis, beta_mean, facet_midpoints, normal_traction,  # noqa: E402
-                          von_mises)
+                          tangent_direction, tangential_traction, von_mises)
 
 AXES = "xyz"
 DPI = 120
@@ -30,7 +30,8 @@ def sample_levels(steps, count=5):
 
 
 def magnification(points, u):
-    """A round factor making max |u| about 10% of the domain's largest extent.
+    """A round factor making max |u| about 10% of the domain's largest extent
+    (1 when the displacements are larger than that already).
 
     Parameters
     ----------
@@ -41,7 +42,8 @@ def magnification(points, u):
     umax = float(np.linalg.norm(u, axis=1).max(initial=0.0))
     if umax == 0.0 or not np.isfinite(umax):
         return 1.0
-    return float(f"{0.1 * extent / umax:.2g}")
+    # large displacements are drawn as they are, never shrunk
+    return max(1.0, float(f"{0.1 * extent / umax:.2g}"))
 
 
 def _title(solution):
@@ -64,10 +66,11 @@ def _deformed_2d(fig, ax, solution, factor):
         ax.plot(p[0, on], p[1, on], "o", color="tab:red", markersize=3,
                 label="contact nodes on the wall")
     ax.set_aspect("equal")
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize="small")
-    fig.colorbar(image, ax=ax, shrink=0.8,
+    ax.set_xlabel("x (units of length)")
+    ax.set_ylabel("y (units of length)")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")
+    # below the axes: a colorbar as wide as a flat domain, never taller than it
+    fig.colorbar(image, ax=ax, location="bottom", shrink=0.7, pad=0.14, aspect=35,
                  label="von Mises stress (in-plane σ; units of E)")
 
 
@@ -102,58 +105,151 @@ def plot_deformed(solution, path):
         _deformed_2d(fig, ax, solution, factor)
     else:
         ax = _deformed_3d(fig, solution, factor)
-    ax.set_title(f"{_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, "
-                 f"displacements magnified ×{factor:g}", fontsize="medium")
+    scale = ("displacements to scale" if factor == 1.0 else
+             f"displacements magnified ×{factor:g}")
+    ax.set_title(f"{_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, {scale}",
+                 fontsize="medium")
     fig.savefig(path, dpi=DPI, bbox_inches="tight")
     plt.close(fig)
 
 
+def _tangent_label(problem):
+    """How a positive σ_τ points, for the axis label."""
+    tau = tangent_direction(problem)
+    if tau is None:
+        return "along the nodal tangent τ"
+    big = np.abs(tau) > 1e-9
+    if big.sum() == 1:
+        axis = int(np.flatnonzero(big)[0])
+        return f"> 0 along {'+' if tau[axis] > 0 else '−'}{AXES[axis]}"
+    return "along τ = (" + ", ".join(f"{c:.2g}" for c in tau) + ")"
+
+
 def plot_contact_traction(solution, path):
-    """Normal traction and normal displacement along Γ_C at a few levels."""
+    """Normal and tangential traction and the normal displacement along Γ_C.
+
+    Three panels sharing the coordinate along Γ_C, one curve per sampled
+    time level: the normal traction −σ_ν (compression > 0), the tangential
+    traction σ_τ (2D: its component along the nodal tangent; 3D: |σ_τ|),
+    both the nodal force of Γ_C on the body over the lumped nodal weight,
+    and u_ν with the gap. Nodes on the wall are ringed; with a friction kink
+    stuck nodes are marked by squares on the tangential panel."""
     problem = solution.problem
     boundary = problem.boundary
     x_nodes = problem.mesh.p[:, boundary.nodes]
     axis = along_axis(x_nodes)
     order = np.argsort(x_nodes[axis], kind="stable")
     x = x_nodes[axis, order]
-    traction = normal_traction(solution)[:, order]
+    normal = normal_traction(solution)[:, order]
+    shear = tangential_traction(solution)[:, order]
+    shear = shear[:, :, 0] if problem.dim == 2 else np.linalg.norm(shear, axis=2)
     un = solution.normal_displacement[:, order]
     wall = solution.on_wall[:, order]
+    separated = un < 0
+    kinked = problem.friction is not None and problem.friction.has_kink
+    stuck = solution.stuck[:, order] & ~separated
     gap = None if problem.gap is None else problem.gap[:, order]
     style = "-" if problem.dim == 2 else "none"  # 3D: scattered nodes, no lines
 
     levels = sample_levels(solution.steps)
     colours = plt.cm.viridis(np.linspace(0.0, 0.9, levels.size))
-    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(8, 7))
+    fig, (top, middle, bottom) = plt.subplots(3, 1, sharex=True, figsize=(8.5, 9.5))
     for n, colour in zip(levels, colours):
-        top.plot(x, traction[n], linestyle=style, marker=".", color=colour,
-                 label=f"t = {solution.t[n]:g}")
-        top.plot(x[wall[n]], traction[n, wall[n]], "o", color=colour, mfc="none")
+        top.plot(x, normal[n], linestyle=style, marker=".", color=colour,
+                 label=f"t = {solution.t[n]:.4g}")
+        top.plot(x[wall[n]], normal[n, wall[n]], "o", color=colour, mfc="none")
+        middle.plot(x, shear[n], linestyle=style, marker=".", color=colour)
+        if kinked:
+            middle.plot(x[stuck[n]], shear[n, stuck[n]], "s", color=colour, mfc="none",
+                        markersize=6)
         bottom.plot(x, un[n], linestyle=style, marker=".", color=colour)
         bottom.plot(x[wall[n]], un[n, wall[n]], "o", color=colour, mfc="none")
         if gap is not None:
             bottom.plot(x, gap[n], linestyle="--" if style == "-" else "none",
                         marker="" if style == "-" else "_", color=colour, alpha=0.7)
-    top.axhline(0.0, color="0.6", linewidth=0.8)
-    top.set_ylabel("normal traction −σ_ν\n(compression > 0; units of E)")
+    for ax in (top, middle, bottom):
+        ax.axhline(0.0, color="0.6", linewidth=0.8)
+        ax.grid(True, color="0.9", linewidth=0.6)
+    top.set_ylabel("normal traction −σ_ν\n(> 0 compression, < 0 tension;\nunits of E)")
     what = "contact traction and gap" if gap is not None else "contact traction"
     top.set_title(f"{_title(solution)}\n{what} along Γ_C", fontsize="medium")
     top.legend(title="time level", fontsize="small", loc="upper left",
                bbox_to_anchor=(1.01, 1.0))
+    if problem.dim == 2:
+        middle.set_ylabel(f"tangential traction σ_τ\n({_tangent_label(problem)};\n"
+                          "units of E)")
+    else:
+        middle.set_ylabel("tangential traction |σ_τ|\n(units of E)")
+    if problem.friction is None:
+        middle.set_title("no friction law: σ_τ = 0", fontsize="small")
+    if kinked:
+        middle.plot([], [], "s", color="k", mfc="none", label="stuck node\n(ξ = 0 held\n"
+                    "by friction)")
+        middle.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     bottom.plot([], [], linestyle=style, marker=".", color="k", label="u_ν")
     if gap is not None:
         bottom.plot([], [], "--", color="k", label="gap g (the wall)")
         bottom.plot([], [], "o", color="k", mfc="none", label="node on the wall\n(u_ν = g)")
-    bottom.axhline(0.0, color="0.6", linewidth=0.8)
-    bottom.set_ylabel("normal displacement u_ν\n(units of length)")
+    bottom.set_ylabel("normal displacement u_ν\n(> 0 towards the\nfoundation; units of length)")
     bottom.set_xlabel(f"{AXES[axis]} along Γ_C (units of length)")
     bottom.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.align_ylabels((top, middle, bottom))
     fig.savefig(path, dpi=DPI, bbox_inches="tight")
     plt.close(fig)
 
 
+def _time_edges(t):
+    """Cell edges in time around the levels t_n (half a step beyond the ends)."""
+    t = np.asarray(t, dtype=float)
+    if t.size == 1:
+        return np.array([t[0] - 0.5, t[0] + 0.5])
+    mid = 0.5 * (t[1:] + t[:-1])
+    return np.concatenate([[2 * t[0] - mid[0]], mid, [2 * t[-1] - mid[-1]]])
+
+
+def beta_space_time(problem, beta):
+    """β on a space-time grid: (x edges, β image (N+1, nx), x label).
+
+    2D: one column per contact facet, the facets ordered along the axis of
+    largest spread; the columns are the facets' own intervals when these
+    tile a segment (a straight side), else equal widths of the facet
+    measures laid end to end (arc length in that order). 3D: the facets are
+    binned by their midpoint along that axis and β is the measure-weighted
+    mean over each bin (an average across the width of Γ_C)."""
+    boundary = problem.boundary
+    mid = facet_midpoints(problem)
+    axis = along_axis(mid)
+    name = AXES[axis]
+    ends = problem.mesh.p[axis][boundary.facet_nodes]     # (d, nf)
+    if problem.dim == 2:
+        order = np.argsort(mid[axis], kind="stable")
+        lo, hi = ends.min(axis=0)[order], ends.max(axis=0)[order]
+        if np.allclose(hi[:-1], lo[1:]):
+            edges = np.concatenate([lo[:1], hi])
+            return edges, beta[:, order], f"{name} along Γ_C (units of length)"
+        edges = np.concatenate([[0.0], np.cumsum(boundary.measure[order])])
+        return edges, beta[:, order], (f"arc length along Γ_C, facets ordered by {name} "
+                                       "(units of length)")
+    lo, hi = ends.min(), ends.max()
+    nbins = int(np.clip(round(np.sqrt(mid.shape[1])), 1, 60))
+    edges = np.linspace(lo, hi, nbins + 1)
+    which = np.clip(np.searchsorted(edges, mid[axis], side="right") - 1, 0, nbins - 1)
+    weight = np.bincount(which, boundary.measure, minlength=nbins)
+    image = np.full((beta.shape[0], nbins), np.nan)
+    for n in range(beta.shape[0]):
+        sums = np.bincount(which, boundary.measure * beta[n], minlength=nbins)
+        image[n, weight > 0] = sums[weight > 0] / weight[weight > 0]
+    return edges, np.ma.masked_invalid(image), (f"{name} of the facet midpoint (units of "
+                                                "length); β averaged across Γ_C")
+
+
 def plot_beta(solution, path):
-    """β per contact facet along Γ_C at a few levels, and its mean and min in time."""
+    """β along Γ_C: curves at a few levels, a space-time image, mean and min in time.
+
+    Left column (sharing the coordinate along Γ_C): β per facet at a few
+    levels, and below it β(x, t) as an image (x horizontally, t vertically,
+    colour β in [0, 1]) with the β = 1/2 contour when debonding reaches it.
+    Right column: the facet-measure weighted mean and the min of β in time."""
     problem = solution.problem
     mid = facet_midpoints(problem)
     axis = along_axis(mid)
@@ -161,27 +257,62 @@ def plot_beta(solution, path):
     x = mid[axis, order]
     levels = np.unique(np.concatenate([[0], sample_levels(solution.steps)]))
     colours = plt.cm.viridis(np.linspace(0.0, 0.9, levels.size))
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.5),
-                                      gridspec_kw={"width_ratios": [3, 2]})
+    fig = plt.figure(figsize=(12.5, 8.5))
+    # columns: curves / image, colorbar, a spacer for its labels, history
+    grid = fig.add_gridspec(2, 4, width_ratios=[3.0, 0.1, 0.45, 2.0], height_ratios=[1, 1.25],
+                            wspace=0.05, hspace=0.3)
+    curves = fig.add_subplot(grid[0, 0])
+    image_ax = fig.add_subplot(grid[1, 0])
+    bar_ax = fig.add_subplot(grid[1, 1])
+    history = fig.add_subplot(grid[:, 3])
+    edges, image, xlabel = beta_space_time(problem, solution.beta)
+    tiled = problem.dim == 2 and "arc length" not in xlabel   # edges are coordinates
     for n, colour in zip(levels, colours):
-        if problem.dim == 2:
-            left.plot(x, solution.beta[n, order], drawstyle="steps-mid", color=colour,
-                      label=f"t = {solution.t[n]:g}")
+        if tiled:
+            curves.stairs(image[n], edges, color=colour, linewidth=1.5,
+                          label=f"t = {solution.t[n]:.4g}")
+        elif problem.dim == 2:
+            curves.plot(x, solution.beta[n, order], drawstyle="steps-mid", color=colour,
+                        label=f"t = {solution.t[n]:.4g}")
         else:
-            left.plot(x, solution.beta[n, order], ".", color=colour,
-                      label=f"t = {solution.t[n]:g}")
-    left.set(xlabel=f"{AXES[axis]} of the facet midpoint (units of length)",
-             ylabel="bonding β (1 = fully bonded)", ylim=(-0.05, 1.05))
-    left.set_title("β per contact facet", fontsize="medium")
-    left.legend(fontsize="small")
-    right.plot(solution.t, beta_mean(solution), "-", label="mean (weighted by |f|)")
-    right.plot(solution.t, solution.beta.min(axis=1), "--", label="min")
-    right.set(xlabel="time t", ylabel="β", ylim=(-0.05, 1.05))
-    right.set_title("β over Γ_C in time", fontsize="medium")
-    right.legend(fontsize="small")
+            curves.plot(x, solution.beta[n, order], ".", color=colour,
+                        label=f"t = {solution.t[n]:.4g}")
+    curves.set(ylabel="bonding β\n(1 = fully bonded, 0 = debonded)", ylim=(-0.05, 1.05))
+    curves.set_xlabel(f"{AXES[axis]} along Γ_C (units of length)" if tiled else
+                      f"{AXES[axis]} of the facet midpoint (units of length)")
+    curves.set_title("β per contact facet at a few time levels", fontsize="medium")
+    curves.legend(fontsize="small", title="time level", loc="lower left")
+    curves.grid(True, color="0.9", linewidth=0.6)
+
+    t_edges = _time_edges(solution.t)
+    mesh = image_ax.pcolormesh(edges, t_edges, image, cmap="viridis", vmin=0.0, vmax=1.0,
+                               shading="flat", rasterized=True)
+    if tiled:
+        curves.set_xlim(edges[0], edges[-1])   # the image's x range
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    data = np.ma.filled(np.ma.asarray(image, dtype=float), np.nan)
+    if (centres.size > 1 and solution.t.size > 1 and np.nanmin(data) < 0.5
+            and np.nanmax(data) > 0.5):
+        front = image_ax.contour(centres, solution.t, data, levels=[0.5], colors="w",
+                                 linewidths=1.2)
+        image_ax.clabel(front, fmt="β = 1/2", fontsize="small")
+    image_ax.set(xlabel=xlabel, ylabel="time t", ylim=(t_edges[0], t_edges[-1]))
+    image_ax.set_title("β(x, t) on Γ_C (one row per time level)", fontsize="medium")
+    fig.colorbar(mesh, cax=bar_ax, label="bonding β")
+
+    history.plot(solution.t, beta_mean(solution), "-", label="mean (weighted by |f|)")
+    history.plot(solution.t, solution.beta.min(axis=1), "--", label="min over Γ_C")
+    history.plot(solution.t, solution.beta.max(axis=1), ":", color="0.5",
+                 label="max over Γ_C")
+    history.set(xlabel="time t", ylabel="bonding β", ylim=(-0.05, 1.05))
+    history.yaxis.set_label_position("right")
+    history.yaxis.tick_right()
+    history.set_title("β over Γ_C in time", fontsize="medium")
+    history.legend(fontsize="small", loc="lower left")
+    history.grid(True, color="0.9", linewidth=0.6)
     bonding = problem.scene.contact.bonding.law
     frozen = " (bonding law 'none': β frozen at β_0)" if bonding == "none" else ""
-    fig.suptitle(f"{_title(solution)}{frozen}", fontsize="medium")
+    fig.suptitle(f"{_title(solution)}{frozen}\nbonding β along Γ_C", fontsize="medium")
     fig.savefig(path, dpi=DPI, bbox_inches="tight")
     plt.close(fig)
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from adhesive_contact import build_problem, parse_scene
 from adhesive_contact_cli.main import main
 
 # an 8x4 block hanging from its top, pulled down onto a wall with a gap that
@@ -55,7 +56,11 @@ probes = [[1.0, 0.0], [0.0, 0.5]]
 
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
-             "n_wall", "max_penetration", "iterations", "residual"}
+             "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
+             "iterations", "residual"}
+SUMMARY_KEYS = {"scene", "mesh", "smallness", "warnings", "timings", "iterations", "steps"}
+SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds",
+                  "nonconvexity", "step_energy_convex"}
 FILES = {"summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
          "contact.h5", "deformed.png", "contact_traction.png", "beta.png"}
 
@@ -128,8 +133,10 @@ def test_npz_has_the_firm_keys_and_shapes(solved):
 def test_summary_has_one_record_per_level(solved):
     _, out, _ = solved
     summary = strict_json(out / "summary.json")
-    assert set(summary) == {"scene", "mesh", "timings", "iterations", "steps"}
+    assert set(summary) == SUMMARY_KEYS
     assert summary["scene"]["title"] == "test block"
+    assert set(summary["smallness"]) == SMALLNESS_KEYS
+    assert isinstance(summary["warnings"], list)
     assert summary["scene"]["time"]["steps"] == 3
     assert summary["mesh"] == {"nodes": NPOINTS, "cells": NCELLS, "dofs": 2 * NPOINTS,
                                "free_dofs": 2 * NPOINTS - 18, "contact_facets": NFACETS,
@@ -146,6 +153,10 @@ def test_summary_has_one_record_per_level(solved):
         assert step["iterations"] == summary["iterations"][n]
         assert step["beta_mean"] == pytest.approx(1.0)   # no bonding law: β = β_0 = 1
         assert step["beta_min"] == pytest.approx(1.0)
+        assert step["stick"] is None and step["slip"] is None    # no friction law
+        assert step["on_wall"] == step["n_wall"]
+        assert isinstance(step["separated"], int)
+        assert step["separated"] + step["on_wall"] <= 9
     assert steps[0]["n_wall"] == 0
     assert steps[0]["normal_force"] == pytest.approx(0.0)
     assert steps[0]["max_penetration"] == pytest.approx(-0.002)   # min gap, at x = 1
@@ -260,9 +271,13 @@ def test_scene_without_contact_skips_contact_outputs(tmp_path):
         "contact.xdmf", "contact.h5", "contact_traction.png", "beta.png"}
     summary = strict_json(out / "summary.json")
     assert summary["mesh"]["contact_facets"] == 0
+    assert summary["smallness"] is None and summary["warnings"] == []
+    assert "warning:" not in result.stderr
     last = summary["steps"][-1]
     assert last["beta_mean"] is None and last["beta_min"] is None
     assert last["max_penetration"] is None and last["n_wall"] == 0
+    assert (last["separated"], last["on_wall"], last["stick"], last["slip"]) == (0, 0, None,
+                                                                                 None)
     with np.load(out / "solution.npz") as data:
         assert data["contact_facets"].shape == (0, 2)
         assert data["beta"].shape == (NLEVELS, 0)
@@ -388,3 +403,210 @@ def test_the_failing_scene_converges_with_more_iterations(tmp_path):
     assert result.exit_code == 0, result.stderr
     steps = strict_json(tmp_path / "out" / "summary.json")["steps"]
     assert steps[1]["n_wall"] > 0 and steps[1]["iterations"] > 1
+
+
+# --------------------------------------------------------------------------
+# adhesion, friction and bonding: an 8x2 strip clamped on the left, glued to
+# its foundation along the bottom and pulled up and along at its right end;
+# the glue (adhesive_compliance + adhesive_spring) holds while Fremond's law
+# debonds the right end; Tresca friction sticks the left part of Γ_C
+
+FRICTION = """\
+[[contact.friction]]
+law = "tresca"
+mu = 1.0
+
+[[contact.friction]]
+law = "adhesive_spring"
+gamma = 2000.0
+L = 0.01
+"""
+
+GLUED = f"""\
+title = "glued strip"
+dim = 2
+
+[mesh]
+domain = "rectangle"
+size = [2.0, 0.5]
+cells = [8, 2]
+
+[boundary]
+dirichlet = ["left"]
+contact = ["bottom"]
+
+[material]
+E = 1000.0
+nu = 0.3
+
+[memory]
+kernel = "prony"
+terms = [{{ E = 200.0, nu = 0.3, tau = 0.5 }}]
+
+[loads.traction]
+right = ["20*t", "40*t"]
+
+[contact]
+gap = 0.05
+
+[contact.normal]
+law = "adhesive_compliance"
+c = 10000.0
+gamma = 5000.0
+L = 0.01
+
+{FRICTION}
+[contact.bonding]
+law = "fremond"
+beta0 = 1.0
+gamma_nu = 15000.0
+gamma_tau = 7500.0
+eps_a = 0.0
+L = 0.01
+
+[time]
+T = 1.0
+steps = 3
+"""
+
+GLUED_NODES, GLUED_FACETS = 8, 8   # the bottom vertex on Γ_D is not a contact node
+
+
+@pytest.fixture(scope="module")
+def glued(tmp_path_factory):
+    """GLUED solved once: (result, out folder, summary, npz arrays)."""
+    root = tmp_path_factory.mktemp("glued")
+    (root / "glued.toml").write_text(GLUED)
+    out = root / "out"
+    result = run("solve", root / "glued.toml", "--out", out)
+    assert result.exit_code == 0, result.stderr
+    with np.load(out / "solution.npz") as data:
+        arrays = {key: data[key] for key in data.files}
+    return result, out, strict_json(out / "summary.json"), arrays
+
+
+def test_glued_summary_reports_the_smallness_terms(glued):
+    _, _, summary, _ = glued
+    assert set(summary) == SUMMARY_KEYS
+    small = summary["smallness"]
+    assert set(small) == SMALLNESS_KEYS
+    assert isinstance(small["holds"], bool) and isinstance(small["step_energy_convex"], bool)
+    for key in SMALLNESS_KEYS - {"holds", "step_energy_convex"}:
+        assert isinstance(small[key], float), key
+    # what the library estimates, passed through unchanged (its formulas are
+    # tested with the library); m_A = min(2 mu, d lam + 2 mu) checked here
+    expected = build_problem(parse_scene(GLUED)).smallness
+    assert small == pytest.approx(expected, rel=1e-12)
+    E, nu = 1000.0, 0.3
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    assert small["m_A"] == pytest.approx(min(2 * mu, 2 * lam + 2 * mu))
+    assert small["m_nu"] >= 10000.0 and small["m_tau"] > 0   # c; the glue's spring
+    assert small["nonconvexity"] == 0.0 and small["step_energy_convex"] is True  # convex laws
+    assert small["trace_constant_squared"] > 0
+    assert small["rhs"] == pytest.approx(
+        (small["m_tau"] + small["m_nu"]) * small["trace_constant_squared"])
+    assert small["holds"] is (small["m_A"] > small["rhs"])
+
+
+def test_glued_warnings_are_listed_and_printed_before_stepping(glued):
+    result, _, summary, _ = glued
+    warnings = summary["warnings"]
+    assert isinstance(warnings, list) and all(isinstance(w, str) for w in warnings)
+    if not summary["smallness"]["holds"]:
+        assert any("smallness" in w for w in warnings)
+    lines = result.stderr.splitlines()
+    printed = [line for line in lines if line.startswith("warning: ")]
+    assert printed == [f"warning: {w}" for w in warnings]
+    assert "error:" not in result.stderr and "Traceback" not in result.stderr
+    if printed:   # before the progress bar's label, i.e. before the time loop
+        label = next(i for i, line in enumerate(lines) if "glued: 3 steps" in line)
+        assert lines.index(printed[-1]) < label
+
+
+def test_glued_contact_states_are_counts_of_contact_nodes(glued):
+    _, _, summary, _ = glued
+    assert summary["mesh"]["contact_nodes"] == GLUED_NODES
+    steps = summary["steps"]
+    assert len(steps) == NLEVELS
+    for step in steps:
+        assert set(step) == STEP_KEYS
+        counts = [step[key] for key in ("separated", "on_wall", "stick", "slip")]
+        assert all(isinstance(c, int) and c >= 0 for c in counts), counts
+        assert step["stick"] + step["slip"] + step["separated"] <= GLUED_NODES
+        assert step["on_wall"] == step["n_wall"] == 0      # the wall is 0.05 away
+        assert isinstance(step["normal_force"], float)
+        assert isinstance(step["tangential_force"], float)
+    # the scene does something: the right end lifts off and slides
+    assert steps[-1]["separated"] > 0 and steps[-1]["slip"] > 0
+    assert steps[0]["stick"] == GLUED_NODES            # nothing moves at t = 0
+    assert steps[-1]["normal_force"] < 0               # the glue pulls: tension
+
+
+def test_glued_beta_is_a_nonincreasing_history_in_0_1(glued):
+    _, _, _, data = glued
+    beta = data["beta"]
+    assert beta.shape == (NLEVELS, GLUED_FACETS)
+    assert data["contact_facets"].shape == (GLUED_FACETS, 2)
+    assert np.all((beta >= 0) & (beta <= 1))
+    assert np.all(np.diff(beta, axis=0) <= 0)
+    np.testing.assert_allclose(beta[0], 1.0, rtol=1e-12)   # beta0 = 1
+    assert beta[-1].min() < 0.9                       # debonding happened
+
+
+def test_glued_beta_mean_and_min_match_the_npz(glued):
+    _, _, summary, data = glued
+    ends = data["points"][data["contact_facets"]]     # (nf, 2 vertices, 2)
+    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    mean = data["beta"] @ length / length.sum()
+    for n, step in enumerate(summary["steps"]):
+        assert step["beta_mean"] == pytest.approx(mean[n], rel=1e-12)
+        assert step["beta_min"] == pytest.approx(data["beta"][n].min(), rel=1e-12)
+
+
+def test_glued_contact_xdmf_has_beta_per_time_step(glued):
+    _, out, _, data = glued
+    reader = meshio.xdmf.TimeSeriesReader(out / "contact.xdmf")
+    reader.read_points_cells()
+    assert reader.num_steps == NLEVELS
+    for n in range(NLEVELS):
+        t, _, cell_data = reader.read_data(n)
+        assert t == pytest.approx(data["t"][n])
+        np.testing.assert_allclose(cell_data["beta"][0], data["beta"][n])
+
+
+def test_glued_plots_are_written(glued):
+    result, out, _, _ = glued
+    assert "Γ_C at t = 1: β mean" in result.stdout and "slip" in result.stdout
+    assert set(p.name for p in out.iterdir()) == FILES
+    for name in ("contact_traction.png", "beta.png"):
+        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+
+
+BAD_LAWS = [
+    # (id, old text, new text, what the message must contain)
+    ("coulomb", FRICTION, '[contact.friction]\nlaw = "coulomb"\nmu = 1.0\n',
+     "contact.friction.law"),
+    ("nonmonotone a <= b", FRICTION,
+     '[contact.friction]\nlaw = "nonmonotone"\na = 1.0\nb = 2.0\nalpha = 5.0\n',
+     "contact.friction.a"),
+    ("nonmonotone a = b in a list", 'law = "tresca"\nmu = 1.0\n',
+     'law = "nonmonotone"\na = 1.0\nb = 1.0\nalpha = 5.0\n', "contact.friction[0].a"),
+    ("power q 1.5", 'law = "tresca"\nmu = 1.0\n', 'law = "power"\nmu = 1.0\nq = 1.5\n',
+     "contact.friction[0].q"),
+    ("friction entry missing L", 'law = "adhesive_spring"\ngamma = 2000.0\nL = 0.01\n',
+     'law = "adhesive_spring"\ngamma = 2000.0\n', "contact.friction[1].L"),
+    ("bonding glue", 'law = "fremond"', 'law = "glue"', "contact.bonding.law"),
+    ("bonding beta0 1.5", "beta0 = 1.0", "beta0 = 1.5", "contact.bonding.beta0"),
+    ("tresca with gauss", "gap = 0.05\n", 'gap = 0.05\nquadrature = "gauss"\n',
+     "contact.quadrature"),
+]
+
+
+@pytest.mark.parametrize("old, new, key", [case[1:] for case in BAD_LAWS],
+                         ids=[case[0] for case in BAD_LAWS])
+def test_bad_law_exits_2_with_one_line_naming_the_key(tmp_path, old, new, key):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(edit(GLUED, old, new))
+    result = run("solve", scene, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, key)
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written
