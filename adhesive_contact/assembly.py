@@ -89,27 +89,47 @@ def strain_map(basis):
     return B
 
 
-class LoadMap:
-    """t -> ⟨f(t), ·⟩ for body forces and side tractions (expressions)."""
+def vector_of(expressions):
+    """A vector field f(x, y, z, t) -> (d, ...) from d scalar expressions."""
+    def f(x, y=None, z=None, t=0.0):
+        return np.stack([e(x, y, z, t=t) for e in expressions])
+    return f
 
-    def __init__(self, mesh, body, traction, intorder=4):
+
+def is_zero(expressions):
+    return all(e.is_constant and float(e(0.0)) == 0.0 for e in expressions)
+
+
+class LoadMap:
+    """t -> ⟨f(t), ·⟩: body forces and surface loads evaluated at fixed points.
+
+    Parameters
+    ----------
+    mesh : skfem mesh
+    body : vector field f_0(x, y, z, t) -> (d, ...), or None
+    surface : list of (facets, vector field) pairs (tractions f_N on Γ_N
+        sides, and the manufactured load f_C on Γ_C)
+    """
+
+    def __init__(self, mesh, body, surface, intorder=4):
         d = mesh.dim()
         elem = vector_element(d)
         self.parts = []
-        if any(not (e.is_constant and float(e(0.0)) == 0.0) for e in body):
+        if body is not None:
             basis = Basis(mesh, elem, intorder=intorder)
             self.parts.append((body, *quadrature_load_map(basis)))
-        for side, exprs in traction.items():
-            basis = FacetBasis(mesh, elem, facets=mesh.boundaries[side], intorder=intorder)
-            self.parts.append((exprs, *quadrature_load_map(basis)))
+        for facets, field in surface:
+            basis = FacetBasis(mesh, elem, facets=facets, intorder=intorder)
+            self.parts.append((field, *quadrature_load_map(basis)))
         self.ndofs = d * mesh.p.shape[1]
 
     def __call__(self, t):
         f = np.zeros(self.ndofs)
-        for exprs, maps, x in self.parts:
+        for field, maps, x in self.parts:
             coords = list(x) + [None] * (3 - x.shape[0])
-            for expr, m in zip(exprs, maps):
-                f += m @ expr(coords[0], coords[1], coords[2], t=t)
+            values = field(coords[0], coords[1], coords[2], t=t)
+            for c, m in enumerate(maps):
+                f += m @ values[c]
         return f
 
 

@@ -14,12 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1
 
-from .assembly import Assembly, LoadMap
-from .contact_boundary import build_contact_boundary, reference_facet_rule
+from .assembly import Assembly, LoadMap, is_zero, vector_of
+from .contact_boundary import (build_contact_boundary, facet_normals, reference_facet_rule,
+                               tangent_frame)
 from .laws import make_bonding, make_friction, make_normal_law
+from .manufactured import ManufacturedSolution, memory_terms
 from .memory import make_memory
 from .mesh import build_mesh
-from .scene import SceneError
+from .scene import SIDES, SceneError
 from .smallness import smallness
 
 
@@ -44,13 +46,15 @@ class Problem:
     times: np.ndarray         # t_n, n = 0..N
     assembly_seconds: float
     smallness: dict = None    # the terms of MODEL.md §2's condition (with contact)
+    exact: object = None      # ManufacturedSolution, for scenes with [exact]
+    beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
 
     def warnings(self):
         """What the theory does not cover for this scene, one line each."""
         out = []
         s = self.smallness
         if s is not None and not s["holds"]:
-            tail = ("the step energy is still strictly convex (m_A > m_c c_e²), so each "
+            tail = ("the step energy is still strictly convex (m_A > m_c c_e^2), so each "
                     "step has one solution" if s["step_energy_convex"] else
                     "the step energy may be nonconvex: the solver may fail or pick one of "
                     "several solutions")
@@ -140,7 +144,9 @@ def build_problem(scene):
                 raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
                                  f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
         beta0 = np.ones(boundary.facets.size)
-        if scene.contact.beta0 is not None:
+        if scene.contact.beta0 is not None and scene.contact.beta0.is_constant:
+            beta0 = np.full(boundary.facets.size, float(scene.contact.beta0(0.0)))
+        elif scene.contact.beta0 is not None:
             beta0 = _facet_mean(mesh, boundary, scene.contact.beta0)
             if not np.all((beta0 >= 0) & (beta0 <= 1)):
                 raise SceneError("contact.bonding.beta0", "must lie in [0, 1] on Γ_C")
@@ -158,10 +164,45 @@ def build_problem(scene):
                                  "is outside the mesh") from None
         probe_map = scalar.probes(points).tocsr()
 
-    loads = LoadMap(mesh, scene.body, scene.traction)
     normal_law = make_normal_law(scene.contact.normal)
+    bonding = make_bonding(scene.contact.bonding)
+    exact = beta_source = None
+    if scene.exact is None:
+        body = None if is_zero(scene.body) else vector_of(scene.body)
+        surface = [(mesh.boundaries[side], vector_of(exprs))
+                   for side, exprs in scene.traction.items()]
+    else:
+        exact = ManufacturedSolution(scene, normal_law, friction, bonding, memory_terms(scene))
+        body = exact.body_force
+        neumann = [s for s in SIDES[d] if s not in scene.dirichlet + scene.contact_sides]
+        surface = [(mesh.boundaries[side], exact.traction(_side_normal(side, d)[:, None]))
+                   for side in neumann]
+        for side in scene.contact_sides:
+            normal = _side_normal(side, d)
+            tangents = tangent_frame(normal[:, None])[0, :, 1:].T[:, :, None]
+            surface.append((mesh.boundaries[side], exact.contact_load(normal[:, None], tangents)))
+        if boundary is not None:
+            normals = _side_normals_at(mesh, boundary)
+            frames = tangent_frame(normals)                     # (nq, d, d)
+            beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
+            beta0 = _facet_mean(mesh, boundary, exact.beta)
+    loads = LoadMap(mesh, body, surface)
     small = smallness(scene, normal_law, friction) if boundary is not None else None
     return Problem(scene, mesh, assembly, free, clamped, boundary, columns, contact_positions,
-                   loads, gap, beta0, normal_law, friction,
-                   make_bonding(scene.contact.bonding), make_memory(scene.memory),
-                   probe_map, times, time.perf_counter() - t0, small)
+                   loads, gap, beta0, normal_law, friction, bonding, make_memory(scene.memory),
+                   probe_map, times, time.perf_counter() - t0, small, exact, beta_source)
+
+
+def _side_normal(side, d):
+    """The outward unit normal of a named side of the rectangle or box."""
+    axis, sign = {"left": (0, -1), "right": (0, 1), "bottom": (1, -1), "top": (1, 1),
+                  "front": (2, -1), "back": (2, 1)}[side]
+    n = np.zeros(d)
+    n[axis] = sign
+    return n
+
+
+def _side_normals_at(mesh, boundary):
+    """Outward facet normals (d, nq) at the quadrature points of Γ_C."""
+    normals, _ = facet_normals(mesh, boundary.facets)
+    return normals[:, boundary.facet_of_point]

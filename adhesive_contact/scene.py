@@ -81,6 +81,15 @@ class ContactSpec:
 
 
 @dataclass(frozen=True)
+class ExactSpec:
+    """A manufactured solution (MODEL.md §7): u*, β* and the wall multiplier λ*."""
+
+    u: tuple                      # d Expressions in x, y, (z), t
+    beta: object = None           # Expression, or None (β* = 1)
+    multiplier: object = None     # Expression λ* > 0 where u*_ν = g
+
+
+@dataclass(frozen=True)
 class SolverSpec:
     method: str = "newton"
     tol: float = 1e-10
@@ -103,6 +112,7 @@ class Scene:
     steps: int
     solver: SolverSpec
     probes: tuple
+    exact: ExactSpec = None
     resolved: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
@@ -466,6 +476,33 @@ def scene_from_dict(data):
                                  f"got {_show(p)}")
         probes = tuple(tuple(float(c) for c in p) for p in raw)
         output.finish()
+    exact, exact_resolved = None, None
+    exact_table = top.table("exact")
+    if exact_table is not None:
+        if loads is not None:
+            raise SceneError("loads", "a scene with [exact] derives its loads from the exact "
+                             "solution; remove [loads]")
+        variables = coords + ("t",)
+        raw_u = exact_table.get("u", "list")
+        u = _vector_of_expressions("exact.u", raw_u, dim, variables)
+        beta = multiplier = None
+        exact_resolved = {"u": [str(v) for v in raw_u]}
+        if exact_table.has("beta"):
+            raw = exact_table.get("beta", "expr")
+            beta = _expression("exact.beta", raw, variables)
+            exact_resolved["beta"] = str(raw)
+            if beta.depends_on_time and contact.bonding.law == "none":
+                raise SceneError("exact.beta", "depends on t, but contact.bonding.law is "
+                                 "'none' (β frozen); use a bonding law")
+        if exact_table.has("multiplier"):
+            raw = exact_table.get("multiplier", "expr")
+            multiplier = _expression("exact.multiplier", raw, variables)
+            exact_resolved["multiplier"] = str(raw)
+        exact_table.finish()
+        if contact.beta0 is not None:
+            raise SceneError("contact.bonding.beta0", "a scene with [exact] takes β_0 from "
+                             "exact.beta; remove beta0")
+        exact = ExactSpec(u, beta, multiplier)
     top.finish()
 
     resolved = {
@@ -480,9 +517,10 @@ def scene_from_dict(data):
         "time": {"T": T, "steps": steps, "k": T / steps},
         "solver": {"method": solver.method, "tol": solver.tol, "max_iter": solver.max_iter},
         "output": {"probes": [list(p) for p in probes]},
+        "exact": exact_resolved,
     }
     return Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
-                 traction, contact, T, steps, solver, probes, resolved)
+                 traction, contact, T, steps, solver, probes, exact, resolved)
 
 
 def parse_scene(text):

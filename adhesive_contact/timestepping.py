@@ -150,8 +150,10 @@ def solve(problem, progress=None):
         step = op0 if n == 0 else op
         if n >= 1 and bonding is not None:
             # (4.2): β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1})
-            beta_n = beta_n + k * boundary.facet_mean(
-                bonding_rate(boundary, bonding, frame_u[n - 1].ravel(), beta_n))
+            rate = bonding_rate(boundary, bonding, frame_u[n - 1].ravel(), beta_n)
+            if problem.beta_source is not None:   # manufactured solutions only
+                rate = rate + problem.beta_source(*_coords(boundary.points), t=t - k)
+            beta_n = beta_n + k * boundary.facet_mean(rate)
         f = problem.loads(t)
         history = memory.history(n) if n >= 1 else None
         if history is not None:
@@ -210,6 +212,10 @@ def solve(problem, progress=None):
     }
     return Solution(problem, problem.times.copy(), U, beta, stress, stress_zz, force, frame_u, wall,
                     stuck, probes, iterations, residual, timings)
+
+
+def _coords(points):
+    return [points[i] if i < points.shape[0] else None for i in range(3)]
 
 
 def bonding_rate(boundary, bonding, z_full, beta):
