@@ -137,7 +137,9 @@ def solve(problem, progress=None):
     residual = np.zeros(N + 1)
 
     kink = None
-    if problem.friction is not None and problem.friction.has_kink:
+    if problem.friction is not None:
+        # every friction law gets its slip directions held (κ_a = 0 without a
+        # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ
         tangential = np.arange(problem.columns.size).reshape(nc, d)[:, 1:]
         kink = Kink(tangential, np.zeros(nc))
     contact_dofs = None if boundary is None else boundary.dofs.ravel()
@@ -175,7 +177,7 @@ def solve(problem, progress=None):
             # the force of Γ_C on the body: its reaction in the frame equations
             force[n].reshape(-1)[problem.columns] = step.S @ z - c
             wall[n] = result.on_wall[problem.normal_columns]
-            if kink is not None:
+            if kink is not None and problem.friction.has_kink:
                 stuck[n] = result.stuck
             iterations[n], residual[n] = result.nit, result.residual
         u_frame = np.zeros(asm.ndofs)
