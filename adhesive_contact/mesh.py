@@ -46,5 +46,6 @@ def build_mesh(spec):
 
 def mesh_size(mesh):
     """The largest edge length h of the mesh."""
-    p = mesh.p[:, mesh.edges] if hasattr(mesh, "edges") else mesh.p[:, mesh.facets]
+    edges = mesh.facets if mesh.dim() == 2 else mesh.edges
+    p = mesh.p[:, edges]
     return float(np.max(np.linalg.norm(p[:, 1] - p[:, 0], axis=0)))

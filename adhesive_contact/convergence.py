@@ -1,0 +1,165 @@
+"""Convergence studies in h, k or both (MODEL.md §7).
+
+A study refines a scene level by level — ``"h"``: one uniform (nested)
+mesh refinement per level; ``"k"``: the step halved per level; ``"hk"``:
+both — and measures at each level the errors of
+:mod:`adhesive_contact.verification`, max over the level's time grid,
+against
+
+- the scene's exact solution (``reference = "exact"``), or
+- a discrete reference run (``"fine"``) refined ``ref_h`` more times in
+  space and with ``2**ref_k`` times more steps than the finest level; the
+  defaults refine only in what the study varies (2 levels), so that the
+  other error, common to all levels and the reference, cancels.
+
+Everything here is pure computation: the caller stores the level records
+(and the reference) and decides what to recompute.
+"""
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .assembly import stiffness_basis, strain_map
+from .contact_boundary import facet_normals
+from .mesh import mesh_size
+from .problem import build_problem
+from .timestepping import solve
+from .verification import (ExactErrors, facet_parents, fitted_rate, nested_meshes,
+                           prolongation, strain_error_fine)
+
+PARAMS = ("h", "k", "hk")
+
+
+def level_scene(scene, param, level):
+    """The scene of one level of a study."""
+    refine = scene.mesh.refine + (level if param in ("h", "hk") else 0)
+    steps = scene.steps * (2 ** level if param in ("k", "hk") else 1)
+    return replace(scene, mesh=replace(scene.mesh, refine=refine), steps=steps)
+
+
+def default_reference_refinement(param):
+    """(ref_h, ref_k): extra refinements of the reference beyond the finest level."""
+    return (2 if param in ("h", "hk") else 0), (2 if param in ("k", "hk") else 0)
+
+
+def reference_scene(scene, param, levels, ref_h=None, ref_k=None):
+    dh, dk = default_reference_refinement(param)
+    ref_h = dh if ref_h is None else ref_h
+    ref_k = dk if ref_k is None else ref_k
+    finest = level_scene(scene, param, levels - 1)
+    return replace(finest, mesh=replace(finest.mesh, refine=finest.mesh.refine + ref_h),
+                   steps=finest.steps * 2 ** ref_k)
+
+
+@dataclass
+class Reference:
+    """A fine discrete solution: its scene and its history."""
+
+    scene: object
+    t: np.ndarray        # (N+1,)
+    u: np.ndarray        # (N+1, npoints, d)
+    beta: np.ndarray     # (N+1, nf)
+    facets: np.ndarray   # contact facets of the fine mesh, in Γ_C order
+    seconds: float
+
+
+def run_reference(scene, param, levels, ref_h=None, ref_k=None):
+    """Solve the reference run of a study."""
+    ref = reference_scene(scene, param, levels, ref_h, ref_k)
+    t0 = time.perf_counter()
+    problem = build_problem(ref)
+    solution = solve(problem)
+    facets = problem.boundary.facets if problem.boundary is not None else np.zeros(0, int)
+    return Reference(ref, solution.t, solution.u, solution.beta, facets,
+                     time.perf_counter() - t0)
+
+
+def _errors_against_reference(problem, solution, reference):
+    scene = problem.scene
+    meshes = nested_meshes(scene.mesh, reference.scene.mesh.refine - scene.mesh.refine)
+    fine = meshes[-1]
+    P = prolongation(meshes)
+    B = strain_map(stiffness_basis(fine))
+    ratio = reference.scene.steps // scene.steps
+    if ratio * scene.steps != reference.scene.steps:
+        raise ValueError("the reference steps are not a multiple of the level's steps")
+    parents = None
+    if problem.boundary is not None and problem.boundary.facets.size:
+        parents = facet_parents(meshes, problem.boundary.facets, reference.facets)
+    lengths = _facet_lengths(fine, reference.facets)
+    err_u, err_b = [], []
+    for n in range(scene.steps + 1):
+        uf = P @ solution.u[n]                                   # (npoints_f, d)
+        du = (uf - reference.u[n * ratio]).ravel()
+        err_u.append(strain_error_fine(fine, B, du))
+        if parents is None:
+            err_b.append(0.0)
+        else:
+            db = solution.beta[n][parents] - reference.beta[n * ratio]
+            err_b.append(float(np.sqrt(np.sum(lengths * db * db))))
+    return np.array(err_u), np.array(err_b)
+
+
+def _facet_lengths(mesh, facets):
+    if len(facets) == 0:
+        return np.zeros(0)
+    return facet_normals(mesh, facets)[1]
+
+
+def _errors_against_exact(problem, solution):
+    exact = problem.exact
+    errors = ExactErrors(problem, exact.strain,
+                         exact.beta if problem.boundary is not None else None)
+    err_u = np.array([errors.strain(solution.u[n].ravel(), t)
+                      for n, t in enumerate(solution.t)])
+    err_b = np.array([errors.bonding(solution.beta[n], t)
+                      for n, t in enumerate(solution.t)])
+    return err_u, err_b
+
+
+def run_level(scene, param, level, reference=None):
+    """Solve one level and measure its errors: a JSON-able record.
+
+    ``reference`` is a :class:`Reference`, or None to use the scene's exact
+    solution.
+    """
+    lscene = level_scene(scene, param, level)
+    t0 = time.perf_counter()
+    problem = build_problem(lscene)
+    solution = solve(problem)
+    seconds = time.perf_counter() - t0
+    if reference is None:
+        if problem.exact is None:
+            raise ValueError("the scene has no [exact] solution; use a fine reference")
+        err_u, err_b = _errors_against_exact(problem, solution)
+    else:
+        err_u, err_b = _errors_against_reference(problem, solution, reference)
+    E = err_u + err_b
+    return {
+        "level": level, "h": mesh_size(problem.mesh), "k": lscene.k,
+        "dofs": int(problem.ndofs), "steps": lscene.steps, "refine": lscene.mesh.refine,
+        "err_u": float(err_u.max()), "err_beta": float(err_b.max()), "E": float(E.max()),
+        "seconds": seconds, "newton_iterations": int(solution.iterations.sum()),
+    }
+
+
+def rates(records, param):
+    """Least-squares rates {"u", "beta", "E"} against h (or k for a k-study)."""
+    size = "k" if param == "k" else "h"
+    sizes = [r[size] for r in records]
+    return {name: fitted_rate(sizes, [r[key] for r in records])
+            for name, key in (("u", "err_u"), ("beta", "err_beta"), ("E", "E"))}
+
+
+def pairwise_rates(records, param, key="E"):
+    """Rates between consecutive levels (the first is None)."""
+    size = "k" if param == "k" else "h"
+    out = [None]
+    for a, b in zip(records[:-1], records[1:]):
+        if a[key] > 0 and b[key] > 0:
+            out.append(float(np.log(a[key] / b[key]) / np.log(a[size] / b[size])))
+        else:
+            out.append(None)
+    return out
