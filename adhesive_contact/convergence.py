@@ -9,8 +9,8 @@ against
 - the scene's exact solution (``reference = "exact"``), or
 - a discrete reference run (``"fine"``) refined ``ref_h`` more times in
   space and with ``2**ref_k`` times more steps than the finest level; the
-  defaults refine only in what the study varies (2 levels), so that the
-  other error, common to all levels and the reference, cancels.
+  defaults refine only in what the study varies, so that the other error,
+  common to all levels and the reference, cancels.
 
 Everything here is pure computation: the caller stores the level records
 (and the reference) and decides what to recompute.
@@ -40,8 +40,14 @@ def level_scene(scene, param, level):
 
 
 def default_reference_refinement(param):
-    """(ref_h, ref_k): extra refinements of the reference beyond the finest level."""
-    return (2 if param in ("h", "hk") else 0), (2 if param in ("k", "hk") else 0)
+    """(ref_h, ref_k): extra refinements of the reference beyond the finest level.
+
+    Against a reference r refinements finer, a first-order error reads
+    C (s_l − s_ref): the last pairwise rate is biased up to
+    log2((2 − 2^−r)/(1 − 2^−r)), 1.22 for r = 2 and 1.05 for r = 4. Steps
+    are cheap, so k is refined 4 more times; the mesh 2 (16× the cells).
+    """
+    return (2 if param in ("h", "hk") else 0), (4 if param == "k" else (2 if param == "hk" else 0))
 
 
 def reference_scene(scene, param, levels, ref_h=None, ref_k=None):
