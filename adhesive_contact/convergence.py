@@ -16,6 +16,7 @@ Everything here is pure computation: the caller stores the level records
 (and the reference) and decides what to recompute.
 """
 
+import copy
 import time
 from dataclasses import dataclass, replace
 
@@ -32,11 +33,24 @@ from .verification import (ExactErrors, facet_parents, fitted_rate, nested_meshe
 PARAMS = ("h", "k", "hk")
 
 
+def with_discretisation(scene, refine=None, steps=None):
+    """The scene with another mesh refinement and/or number of steps (its
+    resolved record updated to match)."""
+    refine = scene.mesh.refine if refine is None else refine
+    steps = scene.steps if steps is None else steps
+    resolved = copy.deepcopy(scene.resolved)
+    if resolved:
+        resolved["mesh"]["refine"] = refine
+        resolved["time"].update(steps=steps, k=scene.T / steps)
+    return replace(scene, mesh=replace(scene.mesh, refine=refine), steps=steps,
+                   resolved=resolved)
+
+
 def level_scene(scene, param, level):
     """The scene of one level of a study."""
     refine = scene.mesh.refine + (level if param in ("h", "hk") else 0)
     steps = scene.steps * (2 ** level if param in ("k", "hk") else 1)
-    return replace(scene, mesh=replace(scene.mesh, refine=refine), steps=steps)
+    return with_discretisation(scene, refine, steps)
 
 
 def default_reference_refinement(param):
@@ -55,8 +69,7 @@ def reference_scene(scene, param, levels, ref_h=None, ref_k=None):
     ref_h = dh if ref_h is None else ref_h
     ref_k = dk if ref_k is None else ref_k
     finest = level_scene(scene, param, levels - 1)
-    return replace(finest, mesh=replace(finest.mesh, refine=finest.mesh.refine + ref_h),
-                   steps=finest.steps * 2 ** ref_k)
+    return with_discretisation(finest, finest.mesh.refine + ref_h, finest.steps * 2 ** ref_k)
 
 
 @dataclass
@@ -71,12 +84,12 @@ class Reference:
     seconds: float
 
 
-def run_reference(scene, param, levels, ref_h=None, ref_k=None):
-    """Solve the reference run of a study."""
+def run_reference(scene, param, levels, ref_h=None, ref_k=None, progress=None):
+    """Solve the reference run of a study (``progress(n, N)`` per step)."""
     ref = reference_scene(scene, param, levels, ref_h, ref_k)
     t0 = time.perf_counter()
     problem = build_problem(ref)
-    solution = solve(problem)
+    solution = solve(problem, progress)
     facets = problem.boundary.facets if problem.boundary is not None else np.zeros(0, int)
     return Reference(ref, solution.t, solution.u, solution.beta, facets,
                      time.perf_counter() - t0)
@@ -125,16 +138,16 @@ def _errors_against_exact(problem, solution):
     return err_u, err_b
 
 
-def run_level(scene, param, level, reference=None):
+def run_level(scene, param, level, reference=None, progress=None):
     """Solve one level and measure its errors: a JSON-able record.
 
     ``reference`` is a :class:`Reference`, or None to use the scene's exact
-    solution.
+    solution; ``progress(n, N)`` is called per step.
     """
     lscene = level_scene(scene, param, level)
     t0 = time.perf_counter()
     problem = build_problem(lscene)
-    solution = solve(problem)
+    solution = solve(problem, progress)
     seconds = time.perf_counter() - t0
     if reference is None:
         if problem.exact is None:

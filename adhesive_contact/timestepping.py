@@ -34,6 +34,9 @@ class StepFailure(RuntimeError):
             f"after {result.nit} iterations. Try more time steps (smaller k), a larger "
             f"solver.max_iter, or check the smallness condition of the contact laws")
 
+    def __reduce__(self):   # survive pickling back from a worker process
+        return (type(self), (self.n, self.t, self.result))
+
 
 @dataclass
 class Solution:

@@ -11,26 +11,17 @@ and the run goes on.
 """
 
 import sys
-from importlib import resources
 from pathlib import Path
 
 import click
 
-from adhesive_contact import SceneError, StepFailure, build_problem, parse_scene
+from adhesive_contact import StepFailure
 from adhesive_contact import solve as run_scheme
 
+from .common import CliError, echo_warnings, load_scene, read_scene
+from .converge import converge
 from .output import write_outputs
 from .postprocess import beta_mean
-
-DEFAULT_SCENE = "default_scene.toml"
-
-
-class CliError(click.ClickException):
-    """An error reported as one line ``error: message`` with an exit code."""
-
-    def __init__(self, message, exit_code):
-        super().__init__(" ".join(str(message).split()))
-        self.exit_code = exit_code
 
 
 class OneLineGroup(click.Group):
@@ -57,23 +48,6 @@ class OneLineGroup(click.Group):
             click.echo("error: aborted", err=True)
             sys.exit(1)
         sys.exit(code if isinstance(code, int) else 0)
-
-
-def read_scene(path):
-    """The scene's name and TOML text: from ``path``, or the built-in default.
-
-    Raises :class:`CliError` (exit 2) when the file cannot be read."""
-    if path is None:
-        text = resources.files("adhesive_contact_cli").joinpath(DEFAULT_SCENE).read_text(
-            encoding="utf-8")
-        return "default", text
-    try:
-        return path.stem, path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CliError(f"SCENE: no such file {str(path)!r}", 2) from None
-    except (OSError, UnicodeDecodeError) as err:
-        reason = err.strerror if isinstance(err, OSError) and err.strerror else err
-        raise CliError(f"SCENE: cannot read {str(path)!r}: {reason}", 2) from None
 
 
 def check_out(out):
@@ -109,15 +83,10 @@ def solve(scene, out):
     plots into the output folder.
     """
     name, text = read_scene(scene)
-    try:
-        parsed = parse_scene(text)
-        problem = build_problem(parsed)
-    except SceneError as err:
-        raise CliError(str(err), 2) from None
+    parsed, problem = load_scene(text)
     out = Path(out) if out is not None else Path.cwd() / name
     check_out(out)
-    for warning in problem.warnings():
-        click.echo(f"warning: {' '.join(str(warning).split())}", err=True)
+    echo_warnings(problem)
 
     with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
                            file=sys.stderr) as bar:
@@ -147,3 +116,6 @@ def solve(scene, out):
                    f"min {solution.beta[-1].min():.4g}; contact nodes separated "
                    f"{states['separated']}, on the wall {states['on_wall']}{friction}")
     click.echo(f"  wrote {out}/: {', '.join(files)}")
+
+
+main.add_command(converge)

@@ -1,0 +1,54 @@
+"""What the ``adhcontact`` commands share: one-line errors, reading a scene
+file, parsing and validating it, and reporting the problem's warnings.
+
+Every command parses and validates its scene with these before it creates
+any output, so a bad scene exits 2 with one line and writes nothing.
+"""
+
+from importlib import resources
+
+import click
+
+from adhesive_contact import SceneError, build_problem, parse_scene
+
+DEFAULT_SCENE = "default_scene.toml"
+
+
+class CliError(click.ClickException):
+    """An error reported as one line ``error: message`` with an exit code."""
+
+    def __init__(self, message, exit_code):
+        super().__init__(" ".join(str(message).split()))
+        self.exit_code = exit_code
+
+
+def read_scene(path):
+    """The scene's name and TOML text: from ``path``, or the built-in default.
+
+    Raises :class:`CliError` (exit 2) when the file cannot be read."""
+    if path is None:
+        text = resources.files("adhesive_contact_cli").joinpath(DEFAULT_SCENE).read_text(
+            encoding="utf-8")
+        return "default", text
+    try:
+        return path.stem, path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise CliError(f"SCENE: no such file {str(path)!r}", 2) from None
+    except (OSError, UnicodeDecodeError) as err:
+        reason = err.strerror if isinstance(err, OSError) and err.strerror else err
+        raise CliError(f"SCENE: cannot read {str(path)!r}: {reason}", 2) from None
+
+
+def load_scene(text):
+    """(scene, problem) of a TOML scene text; a bad scene is a :class:`CliError` (exit 2)."""
+    try:
+        scene = parse_scene(text)
+        return scene, build_problem(scene)
+    except SceneError as err:
+        raise CliError(str(err), 2) from None
+
+
+def echo_warnings(problem):
+    """One line ``warning: ...`` on stderr per thing the theory does not cover."""
+    for warning in problem.warnings():
+        click.echo(f"warning: {' '.join(str(warning).split())}", err=True)

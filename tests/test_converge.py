@@ -1,0 +1,463 @@
+"""Tests for ``adhcontact converge`` (SPEC.md, "Command line (firm)"; MODEL.md §7):
+the firm outputs, the fine reference, resuming, refusing another study and
+running levels in parallel. Tiny scenes (4x2 cells, a few steps, 3 levels)."""
+
+import inspect
+import json
+import shutil
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import adhesive_contact_cli.converge as converge_module
+from adhesive_contact import StepFailure, parse_scene
+from adhesive_contact.convergence import default_reference_refinement, run_reference
+from adhesive_contact_cli.main import main
+
+# no contact: u* is smooth and the library derives body force and tractions;
+# 8 steps keep the time error below the space error of the 3 levels
+EXACT_SCENE = """\
+title = "manufactured, no contact"
+dim = 2
+
+[mesh]
+domain = "rectangle"
+size = [1.0, 0.5]
+cells = [4, 2]
+
+[boundary]
+dirichlet = ["left"]
+
+[material]
+E = 1000.0
+nu = 0.3
+
+[memory]
+kernel = "prony"
+terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
+
+[time]
+T = 1.0
+steps = 8
+
+[exact]
+u = ["0.01*x*x*(1+t)", "0.005*x*y"]
+"""
+
+# a block hanging from its top, pressed by its weight onto a compliant wall
+CONTACT_SCENE = """\
+title = "small block on a compliant wall"
+dim = 2
+
+[mesh]
+domain = "rectangle"
+size = [1.0, 0.5]
+cells = [4, 2]
+
+[boundary]
+dirichlet = ["top"]
+contact = ["bottom"]
+
+[material]
+E = 1000.0
+nu = 0.3
+
+[memory]
+kernel = "prony"
+terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
+
+[loads]
+body = ["0", "-400*t"]
+
+[contact]
+gap = "0.001 + 0.01*(x - 0.5)**2"
+
+[contact.normal]
+law = "compliance"
+c = 300.0
+
+[time]
+T = 1.0
+steps = 2
+"""
+
+REF_K = default_reference_refinement("k")[1]
+FIRM_LEVEL_KEYS = {"h", "k", "dofs", "err_u", "err_beta", "E", "seconds"}
+CSV_COLUMNS = ["level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
+               "seconds"]
+
+
+def runner():
+    """A CliRunner keeping stderr apart (click >= 8.2 always does)."""
+    if "mix_stderr" in inspect.signature(CliRunner).parameters:
+        return CliRunner(mix_stderr=False)
+    return CliRunner()
+
+
+def run(*args):
+    return runner().invoke(main, ["converge", *map(str, args)], catch_exceptions=False)
+
+
+def strict_json(path):
+    """Load JSON, failing on NaN or Infinity (not JSON)."""
+    def refuse(name):
+        raise ValueError(f"{name} in {path}")
+    return json.loads(path.read_text(), parse_constant=refuse)
+
+
+def assert_one_line_error(result, code, needle):
+    assert result.exit_code == code, (result.stdout, result.stderr)
+    errors = [line for line in result.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1, result.stderr
+    assert needle in errors[0], errors[0]
+    assert "Traceback" not in result.stderr + result.stdout
+
+
+def snapshot(folder):
+    """{relative path: bytes} of every file under ``folder``."""
+    return {str(p.relative_to(folder)): p.read_bytes()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def read_csv(path):
+    lines = path.read_text().splitlines()
+    return lines[0].split(","), [line.split(",") for line in lines[1:]]
+
+
+@pytest.fixture(scope="module")
+def scenes(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("scenes")
+    (folder / "exact.toml").write_text(EXACT_SCENE)
+    (folder / "contact.toml").write_text(CONTACT_SCENE)
+    return SimpleNamespace(exact=folder / "exact.toml", contact=folder / "contact.toml")
+
+
+@pytest.fixture(scope="module")
+def exact_study(scenes, tmp_path_factory):
+    """An h-study of the exact scene, 3 levels (reference exact by default)."""
+    out = tmp_path_factory.mktemp("exact") / "out"
+    result = run(scenes.exact, "--param", "h", "--levels", 3, "--out", out)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    return SimpleNamespace(out=out, result=result)
+
+
+@pytest.fixture(scope="module")
+def fine_study(scenes, tmp_path_factory):
+    """A k-study of the contact scene against a fine reference, 3 levels."""
+    out = tmp_path_factory.mktemp("fine") / "out"
+    result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    return SimpleNamespace(out=out, result=result)
+
+
+@pytest.fixture
+def counting(monkeypatch):
+    """Count the calls of run_level (by level) and run_reference made by the CLI."""
+    calls = SimpleNamespace(levels=[], reference=0)
+    real_level, real_reference = converge_module.run_level, converge_module.run_reference
+
+    def run_level(scene, param, level, reference=None):
+        calls.levels.append(level)
+        return real_level(scene, param, level, reference)
+
+    def run_reference(*args, **kwargs):
+        calls.reference += 1
+        return real_reference(*args, **kwargs)
+
+    monkeypatch.setattr(converge_module, "run_level", run_level)
+    monkeypatch.setattr(converge_module, "run_reference", run_reference)
+    return calls
+
+
+# ---------------------------------------------------------------- (1) exact
+
+
+def test_exact_study_writes_the_firm_outputs(exact_study):
+    out = exact_study.out
+    assert {p.name for p in out.iterdir()} == {
+        "study.json", "levels", "errors.csv", "rates.json", "error_vs_h.png",
+        "work_precision.png"}
+    assert sorted(p.name for p in (out / "levels").iterdir()) == [
+        "level_00.json", "level_01.json", "level_02.json"]
+    for png in ("error_vs_h.png", "work_precision.png"):
+        data = (out / png).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
+
+    doc = strict_json(out / "rates.json")
+    assert doc["param"] == "h"
+    assert set(doc["rates"]) == {"u", "beta", "E"}
+    assert doc["reference"]["kind"] == "exact"
+    levels = doc["levels"]
+    assert len(levels) == 3
+    for n, level in enumerate(levels):
+        assert FIRM_LEVEL_KEYS <= set(level)
+        assert level["level"] == n and level["steps"] == 8 and level["k"] == 0.125
+        assert level["err_beta"] == 0.0          # no contact boundary
+        assert level["E"] == pytest.approx(level["err_u"] + level["err_beta"], rel=1e-14)
+        assert level["seconds"] > 0
+    hs = np.array([level["h"] for level in levels])
+    np.testing.assert_allclose(hs[1:] / hs[:-1], 0.5, rtol=1e-12)    # nested refinement
+    assert [level["dofs"] for level in levels] == [30, 90, 306]
+    E = np.array([level["E"] for level in levels])
+    assert np.all(np.diff(E) < 0)
+    # the least-squares slope of log E against log h, first order
+    assert doc["rates"]["E"] > 0.8
+    assert doc["rates"]["E"] == pytest.approx(np.polyfit(np.log(hs), np.log(E), 1)[0],
+                                              rel=1e-9)
+    assert doc["rates"]["u"] == doc["rates"]["E"]
+    assert doc["rates"]["beta"] is None          # no β error to fit: NaN -> null
+    assert levels[0]["rate_E"] is None
+    assert levels[1]["rate_E"] == pytest.approx(np.log(E[0] / E[1]) / np.log(2), rel=1e-9)
+
+    header, rows = read_csv(out / "errors.csv")
+    assert header == CSV_COLUMNS
+    assert len(rows) == 3
+    for row, level in zip(rows, levels):
+        record = dict(zip(header, row))
+        assert float(record["E"]) == level["E"] and int(record["dofs"]) == level["dofs"]
+    assert rows[0][header.index("rate_E")] == ""
+
+    study = strict_json(out / "study.json")
+    assert (study["param"], study["levels"], study["reference"]) == ("h", 3, "exact")
+    assert study["ref_h"] is None and study["ref_k"] is None
+    assert study["scene"]["exact"]["u"] == ["0.01*x*x*(1+t)", "0.005*x*y"]
+    assert len(study["sha256"]) == 64
+
+    stdout = exact_study.result.stdout
+    assert "‖ε(u−u_h)‖" in stdout and "least-squares rates" in stdout
+    assert "needed" in exact_study.result.stderr or ">= 4" in exact_study.result.stderr
+
+
+def test_default_out_is_named_after_the_scene_and_param(scenes, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = run(scenes.exact, "--param", "k", "--levels", 2)
+    assert result.exit_code == 0, result.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["exact-converge-k"]
+    assert (tmp_path / "exact-converge-k" / "error_vs_k.png").is_file()
+    doc = strict_json(tmp_path / "exact-converge-k" / "rates.json")
+    assert [level["k"] for level in doc["levels"]] == [0.125, 0.0625]
+
+
+# ---------------------------------------------------------------- (2) fine
+
+
+def test_fine_reference_k_study(fine_study, scenes):
+    out = fine_study.out
+    assert {p.name for p in out.iterdir()} == {
+        "study.json", "levels", "reference.npz", "errors.csv", "rates.json",
+        "error_vs_k.png", "work_precision.png"}
+    doc = strict_json(out / "rates.json")
+    assert doc["param"] == "k"
+    levels = doc["levels"]
+    assert [level["steps"] for level in levels] == [2, 4, 8]
+    assert len({level["h"] for level in levels}) == 1
+    assert len({level["dofs"] for level in levels}) == 1
+    E = np.array([level["E"] for level in levels])
+    assert np.all(E > 0) and np.all(np.diff(E) < 0)
+    assert doc["rates"]["E"] > 0.8
+    # the reference: the library's default refinement for a k-study beyond the
+    # finest level (8 steps)
+    ref_h, ref_k = default_reference_refinement("k")
+    steps = 8 * 2 ** ref_k
+    info = doc["reference"]
+    assert (info["kind"], info["ref_h"], info["ref_k"], info["steps"], info["refine"]) == \
+        ("fine", ref_h, ref_k, steps, ref_h)
+    assert ref_k >= 1 and info["k"] == 1.0 / steps
+    with np.load(out / "reference.npz") as saved:
+        assert {"t", "u", "beta", "facets", "refine", "steps", "seconds"} <= set(saved.files)
+        assert int(saved["steps"]) == steps and int(saved["refine"]) == ref_h
+        assert saved["u"].shape[0] == steps + 1 and saved["u"].shape[2] == 2
+        assert float(saved["seconds"]) == info["seconds"]
+        fresh = run_reference(parse_scene(CONTACT_SCENE), "k", 3)
+        np.testing.assert_allclose(saved["t"], fresh.t, rtol=0, atol=1e-15)
+        np.testing.assert_allclose(saved["u"], fresh.u, rtol=0, atol=1e-15)
+        np.testing.assert_array_equal(saved["facets"], fresh.facets)
+    assert np.abs(fresh.u[-1]).max() > 1e-4      # the block moves: the errors mean something
+
+
+# ---------------------------------------------------------------- (3) resume
+
+
+def test_rerun_recomputes_nothing(fine_study, tmp_path, scenes, counting):
+    out = tmp_path / "out"
+    shutil.copytree(fine_study.out, out)
+    before = snapshot(out)
+    result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert counting.levels == [] and counting.reference == 0
+    assert snapshot(out) == before           # rates.json, errors.csv, ... identical
+    assert "0 of 3 levels computed now" in result.stdout
+
+
+def test_interrupted_study_computes_only_the_missing_levels(fine_study, tmp_path, scenes,
+                                                            counting, monkeypatch):
+    out = tmp_path / "out"
+    counted = converge_module.run_level
+
+    def fail_on_level_2(scene, param, level, reference=None):
+        if level == 2:
+            raise StepFailure(3, 0.375, SimpleNamespace(message="simulated failure",
+                                                        residual=1.0, tolerance=1e-10, nit=50))
+        return counted(scene, param, level, reference)
+
+    monkeypatch.setattr(converge_module, "run_level", fail_on_level_2)
+    result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)
+    assert_one_line_error(result, 1, "simulated failure")
+    assert "level 2" in result.stderr
+    assert counting.levels == [0, 1] and counting.reference == 1
+    assert sorted(p.name for p in out.iterdir()) == ["levels", "reference.npz", "study.json"]
+    assert sorted(p.name for p in (out / "levels").iterdir()) == [
+        "level_00.json", "level_01.json"]
+
+    monkeypatch.setattr(converge_module, "run_level", counted)
+    result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert counting.levels == [0, 1, 2] and counting.reference == 1   # only level 2 now
+    resumed = strict_json(out / "rates.json")
+    whole = strict_json(fine_study.out / "rates.json")
+    for key in ("err_u", "err_beta", "E", "h", "k", "dofs"):
+        np.testing.assert_allclose([level[key] for level in resumed["levels"]],
+                                   [level[key] for level in whole["levels"]],
+                                   rtol=1e-12, atol=0)
+
+
+# ---------------------------------------------------------------- (4) another study
+
+
+@pytest.mark.parametrize("change, needle", [
+    (("--levels", "4"), "levels 3 there, 4 here"),
+    (("--ref-k", str(REF_K + 1)), f"ref_k {REF_K} there, {REF_K + 1} here"),
+    (("--param", "hk"), "param 'k' there, 'hk' here"),
+    ("scene", "another scene"),
+])
+def test_another_study_in_the_same_out_exits_2(fine_study, tmp_path, scenes, change, needle,
+                                               counting):
+    out = tmp_path / "out"
+    shutil.copytree(fine_study.out, out)
+    before = snapshot(out)
+    args = {"--param": "k", "--levels": "3"}
+    scene = scenes.contact
+    if change == "scene":
+        scene = tmp_path / "contact.toml"
+        scene.write_text(CONTACT_SCENE.replace("c = 300.0", "c = 400.0"))
+    else:
+        args[change[0]] = change[1]
+    flat = [item for pair in args.items() for item in pair]
+    result = run(scene, *flat, "--out", out)
+    assert_one_line_error(result, 2, "holds a different study")
+    assert needle in result.stderr
+    assert "use another --out or remove it" in result.stderr
+    assert snapshot(out) == before
+    assert counting.levels == [] and counting.reference == 0
+
+
+def test_non_empty_folder_without_a_study_is_left_alone(tmp_path, scenes):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    result = run(scenes.exact, "--param", "h", "--levels", 2, "--out", out)
+    assert_one_line_error(result, 2, "--out")
+    assert snapshot(out) == {"notes.txt": b"keep me"}
+
+
+# ---------------------------------------------------------------- (5) bad arguments
+
+
+@pytest.mark.parametrize("args, needle", [
+    (("--param", "h", "--reference", "exact"), "--reference"),
+    (("--param", "x"), "--param"),
+    (("--param", "h", "--levels", "1"), "--levels"),
+    (("--param", "h", "--jobs", "0"), "--jobs"),
+    (("--levels", "3",), "--param"),
+])
+def test_bad_arguments_exit_2_and_write_nothing(tmp_path, scenes, monkeypatch, args, needle):
+    monkeypatch.chdir(tmp_path)
+    result = run(scenes.contact, *args, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, needle)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_exact_reference_without_exact_table_names_what_is_allowed(tmp_path, scenes):
+    result = run(scenes.contact, "--param", "h", "--reference", "exact", "--out",
+                 tmp_path / "out")
+    assert_one_line_error(result, 2, "--reference")
+    assert "fine" in result.stderr and "[exact]" in result.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_ref_refinement_with_exact_reference_exits_2(tmp_path, scenes):
+    result = run(scenes.exact, "--param", "h", "--ref-h", "1", "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "--ref-h")
+    assert not (tmp_path / "out").exists()
+
+
+def test_bad_scene_exits_2_and_writes_nothing(tmp_path):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(CONTACT_SCENE.replace("nu = 0.3\n\n[memory]", "nu = 0.7\n\n[memory]"))
+    result = run(scene, "--param", "h", "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "nu")
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
+
+
+# ---------------------------------------------------------------- (6) --jobs
+
+
+def test_parallel_levels_give_the_same_errors(fine_study, tmp_path, scenes):
+    out = tmp_path / "out"
+    result = run(scenes.contact, "--param", "k", "--levels", 3, "--jobs", 2, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    parallel = strict_json(out / "rates.json")["levels"]
+    serial = strict_json(fine_study.out / "rates.json")["levels"]
+    for key in ("err_u", "err_beta", "E"):
+        np.testing.assert_allclose([level[key] for level in parallel],
+                                   [level[key] for level in serial], rtol=0, atol=1e-12)
+    assert [level["steps"] for level in parallel] == [2, 4, 8]
+
+
+def test_step_failure_exits_1_in_the_reference_and_in_a_worker(fine_study, tmp_path, counting):
+    """A stiff wall and one Newton iteration: every run fails at step 1. The
+    reference failure leaves study.json only; with a reference in place the
+    levels fail in the worker processes, and the message reaches the user."""
+    scene = tmp_path / "fail.toml"
+    scene.write_text(CONTACT_SCENE.replace("c = 300.0", "c = 5000.0")
+                     + "\n[solver]\nmax_iter = 1\n")
+    out = tmp_path / "out"
+    args = (scene, "--param", "k", "--levels", 3, "--jobs", 2, "--out", out)
+    result = run(*args)
+    assert_one_line_error(result, 1, "reference run: step 1")
+    assert "did not converge" in result.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["levels", "study.json"]
+    assert counting.reference == 1
+
+    shutil.copy(fine_study.out / "reference.npz", out / "reference.npz")
+    result = run(*args)
+    assert_one_line_error(result, 1, "did not converge")
+    error = result.stderr.strip().splitlines()[-1]
+    assert error.startswith("error: level ") and "step 1" in error
+    failed = int(error.split()[2].rstrip(":"))
+    assert counting.reference == 1 and counting.levels == []   # levels ran in workers
+    saved = {p.name for p in (out / "levels").iterdir()}
+    assert f"level_{failed:02d}.json" not in saved and len(saved) < 3
+    assert not (out / "rates.json").exists()
+
+
+def test_level0_refine_and_steps_override_the_scene(scenes, tmp_path):
+    """--refine/--steps set level 0: an h-study keeps --steps at every level,
+    a k-study starts from --refine; both enter the study (another study in
+    the same folder is refused)."""
+    out = tmp_path / "h"
+    result = run(scenes.exact, "--param", "h", "--levels", 2, "--steps", 16, "--out", out)
+    assert result.exit_code == 0, result.output
+    levels = strict_json(out / "rates.json")["levels"]
+    assert [lv["steps"] for lv in levels] == [16, 16]
+    assert [lv["refine"] for lv in levels] == [0, 1]
+    again = run(scenes.exact, "--param", "h", "--levels", 2, "--steps", 8, "--out", out)
+    assert again.exit_code == 2
+    out = tmp_path / "k"
+    result = run(scenes.exact, "--param", "k", "--levels", 2, "--refine", 1, "--out", out)
+    assert result.exit_code == 0, result.output
+    levels = strict_json(out / "rates.json")["levels"]
+    assert [lv["refine"] for lv in levels] == [1, 1]
+    assert [lv["steps"] for lv in levels] == [8, 16]
