@@ -243,7 +243,7 @@ def run_missing(missing, save, scene, text, base, param, levels, ref_h, ref_k, r
     ``jobs`` > 1 runs them in that many worker processes (spawned). A
     StepFailure in any level becomes a :class:`CliError` (exit 1) once the
     levels already running have finished (and been saved)."""
-    if jobs == 1 or len(missing) == 1:
+    if jobs == 1 or len(missing) <= 1:
         for level in missing:
             try:
                 record = run_level(scene, param, level, reference)

@@ -461,3 +461,13 @@ def test_level0_refine_and_steps_override_the_scene(scenes, tmp_path):
     levels = strict_json(out / "rates.json")["levels"]
     assert [lv["refine"] for lv in levels] == [1, 1]
     assert [lv["steps"] for lv in levels] == [8, 16]
+
+
+def test_finished_study_rerun_with_jobs_computes_nothing(fine_study, tmp_path, scenes,
+                                                         counting):
+    """A finished study rerun with --jobs 2 loads every level (no pool of zero workers)."""
+    out = tmp_path / "study"
+    shutil.copytree(fine_study.out, out)
+    result = run(scenes.contact, "--param", "k", "--levels", 3, "--jobs", 2, "--out", out)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    assert counting.levels == [] and counting.reference == 0

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Reruns (resumes) every committed convergence study; see studies/README.md.
+# h-studies: 5 mesh levels at a fixed, small k against the exact solution;
+# k-studies: 5 step levels on a fixed mesh against a fine-in-time reference
+#   (the same mesh, 16x the steps of the finest level), which isolates the
+#   time error; hk-studies: both halved together against the exact solution.
+set -euo pipefail
+cd "$(dirname "$0")"
+out=results
+jobs=${JOBS:-2}
+for case in a_separated_slipping b_wall_multiplier c_stick_slip d_uneven_debonding; do
+    steps_h=256
+    [ "$case" = d_uneven_debonding ] && steps_h=2048
+    adhcontact converge "$case.toml" --param h --levels 5 --steps "$steps_h" --jobs "$jobs" --out "$out/$case-h"
+    adhcontact converge "$case.toml" --param k --levels 5 --refine 2 --steps 4 --reference fine --jobs "$jobs" --out "$out/$case-k"
+    adhcontact converge "$case.toml" --param hk --levels 5 --steps 4 --jobs "$jobs" --out "$out/$case-hk"
+done
+# (e): a realistic peel without an exact solution, against fine reference runs
+# (the mesh refined twice more for h, 16x the steps for k, both for hk)
+case=e_peel_reference
+adhcontact converge "$case.toml" --param h --levels 5 --reference fine --jobs "$jobs" --out "$out/$case-h"
+adhcontact converge "$case.toml" --param k --levels 5 --refine 2 --steps 4 --reference fine --jobs "$jobs" --out "$out/$case-k"
+adhcontact converge "$case.toml" --param hk --levels 5 --steps 4 --reference fine --jobs "$jobs" --out "$out/$case-hk"
