@@ -14,10 +14,19 @@ points, so a step costs one evaluation and one sparse product.
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import (Basis, BilinearForm, ElementTetP1, ElementTriP1, ElementVector,
-                   FacetBasis, asm)
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementTetP1,
+    ElementTriP1,
+    ElementVector,
+    FacetBasis,
+    asm,
+)
 from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
+
+from .expressions import coordinates
 
 
 @BilinearForm
@@ -126,8 +135,7 @@ class LoadMap:
     def __call__(self, t):
         f = np.zeros(self.ndofs)
         for field, maps, x in self.parts:
-            coords = list(x) + [None] * (3 - x.shape[0])
-            values = field(coords[0], coords[1], coords[2], t=t)
+            values = field(*coordinates(x), t=t)
             for c, m in enumerate(maps):
                 f += m @ values[c]
         return f

@@ -27,8 +27,14 @@ from .contact_boundary import facet_normals
 from .mesh import mesh_size
 from .problem import build_problem
 from .timestepping import solve
-from .verification import (ExactErrors, facet_parents, fitted_rate, nested_meshes,
-                           prolongation, strain_error_fine)
+from .verification import (
+    ExactErrors,
+    facet_parents,
+    fitted_rate,
+    nested_meshes,
+    prolongation,
+    strain_error_fine,
+)
 
 PARAMS = ("h", "k", "hk")
 

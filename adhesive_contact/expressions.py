@@ -16,7 +16,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ['ExpressionError', 'Expression', 'compile_expression']
+__all__ = ['ExpressionError', 'Expression', 'compile_expression', 'coordinates']
 
 MAX_LENGTH = 2000
 MAX_DEPTH = 100
@@ -273,3 +273,9 @@ def compile_expression(source):
     uses = set()
     _check(tree, uses)
     return Expression(source, tree, uses)
+
+
+def coordinates(points):
+    """Split points (d, ...) into the arguments ``x, y, z`` of an expression
+    (``None`` for the coordinates a 2D problem does not have)."""
+    return [points[i] if i < points.shape[0] else None for i in range(3)]

@@ -24,7 +24,6 @@ import ast
 
 import numpy as np
 
-
 _GAUSS_POINTS = 16   # Gauss–Legendre points in s for the memory integral (exact to
                      # round-off for the smooth integrands of manufactured data)
 

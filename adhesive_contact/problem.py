@@ -15,8 +15,13 @@ import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1
 
 from .assembly import Assembly, LoadMap, is_zero, vector_of
-from .contact_boundary import (build_contact_boundary, facet_normals, reference_facet_rule,
-                               tangent_frame)
+from .contact_boundary import (
+    build_contact_boundary,
+    facet_normals,
+    reference_facet_rule,
+    tangent_frame,
+)
+from .expressions import coordinates
 from .laws import make_bonding, make_friction, make_normal_law
 from .manufactured import ManufacturedSolution, memory_terms
 from .memory import make_memory
@@ -88,17 +93,12 @@ class Problem:
         return upper
 
 
-def _coords(points):
-    d = points.shape[0]
-    return [points[i] if i < d else None for i in range(3)]
-
-
 def _facet_mean(mesh, boundary, expr, order=4):
     """P_B of an expression: its mean over each contact facet (Gauss rule)."""
     d = mesh.dim()
     shapes, weights = reference_facet_rule(d, "gauss", order)
     x = np.einsum("qv,dvf->dfq", shapes, mesh.p[:, boundary.facet_nodes])
-    values = expr(*_coords(x.reshape(d, -1))).reshape(x.shape[1:])
+    values = expr(*coordinates(x.reshape(d, -1))).reshape(x.shape[1:])
     return values @ weights
 
 
@@ -135,7 +135,7 @@ def build_problem(scene):
         columns = boundary.unknowns([0] if normal_only else np.arange(d))
         contact_positions = position[boundary.dofs.ravel()[columns]]
         if scene.contact.gap is not None:
-            x = _coords(mesh.p[:, boundary.nodes])
+            x = coordinates(mesh.p[:, boundary.nodes])
             gap = np.array([scene.contact.gap(*x, t=t) for t in times])
             bad = ~(np.isfinite(gap) & (gap >= 0))
             if bad.any():

@@ -18,8 +18,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .linear import CondensedOperator
 from .contact_energy import ContactEnergy
+from .expressions import coordinates
+from .linear import CondensedOperator
 from .step_solver import Kink, minimise_step
 
 
@@ -168,7 +169,7 @@ def _solve(problem, progress):
             # (4.2): β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1})
             rate = bonding_rate(boundary, bonding, frame_u[n - 1].ravel(), beta_n)
             if problem.beta_source is not None:   # manufactured solutions only
-                rate = rate + problem.beta_source(*_coords(boundary.points), t=t - k)
+                rate = rate + problem.beta_source(*coordinates(boundary.points), t=t - k)
             beta_n = beta_n + k * boundary.facet_mean(rate)
         f = problem.loads(t)
         history = memory.history(n) if n >= 1 else None
@@ -228,10 +229,6 @@ def _solve(problem, progress):
     }
     return Solution(problem, problem.times.copy(), U, beta, stress, stress_zz, force, frame_u, wall,
                     stuck, probes, iterations, residual, timings)
-
-
-def _coords(points):
-    return [points[i] if i < points.shape[0] else None for i in range(3)]
 
 
 def bonding_rate(boundary, bonding, z_full, beta):

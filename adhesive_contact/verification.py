@@ -26,6 +26,7 @@ from skfem.quadrature import get_quadrature
 
 from .assembly import vector_element
 from .contact_boundary import reference_facet_rule
+from .expressions import coordinates
 from .mesh import build_mesh
 
 
@@ -98,10 +99,6 @@ def cell_volumes(mesh):
     return np.abs(np.linalg.det(J.transpose(2, 0, 1))) / (2.0 if d == 2 else 6.0)
 
 
-def _coords(x):
-    return [x[i] if i < x.shape[0] else None for i in range(3)]
-
-
 class ExactErrors:
     """Errors against an exact solution on one mesh: fixed quadrature points."""
 
@@ -124,9 +121,8 @@ class ExactErrors:
 
     def strain(self, u, t):
         """‖ε(u*(t)) − ε(u_h)‖_{L²(Ω)} with u a dof vector."""
-        d = self.x.shape[0]
         eh = self.assembly.cell_strain(u)                           # (ncells, d, d)
-        ex = self.strain_of(*_coords(self.x), t=t)                  # (d, d, ncells, nq)
+        ex = self.strain_of(*coordinates(self.x), t=t)              # (d, d, ncells, nq)
         diff = ex - eh.transpose(1, 2, 0)[:, :, :, None]
         return float(np.sqrt(np.sum(self.dx * np.sum(diff * diff, axis=(0, 1)))))
 
@@ -134,7 +130,7 @@ class ExactErrors:
         """‖β*(t) − β_h‖_{L²(Γ_C)} with β_h per contact facet."""
         if self.boundary is None or self.beta_of is None:
             return 0.0
-        diff = self.beta_of(*_coords(self.facet_x), t=t) - beta_h[:, None]
+        diff = self.beta_of(*coordinates(self.facet_x), t=t) - beta_h[:, None]
         return float(np.sqrt(np.sum(self.facet_w * diff * diff)))
 
 

@@ -37,19 +37,25 @@ from dataclasses import replace
 from pathlib import Path
 
 import click
+import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 import numpy as np
 
 from adhesive_contact import StepFailure, parse_scene
-from adhesive_contact.convergence import (PARAMS, Reference, default_reference_refinement,
-                                          pairwise_rates, rates, reference_scene, run_level,
-                                          with_discretisation,
-                                          run_reference)
+from adhesive_contact.convergence import (
+    PARAMS,
+    Reference,
+    default_reference_refinement,
+    pairwise_rates,
+    rates,
+    reference_scene,
+    run_level,
+    run_reference,
+    with_discretisation,
+)
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .plots import DPI
 from .postprocess import json_number
-
-import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 
 STUDY = "study.json"
 REFERENCE = "reference.npz"

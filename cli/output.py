@@ -28,8 +28,14 @@ import meshio
 import numpy as np
 
 from . import plots
-from .postprocess import (json_number, pad_tensors, pad_vectors, smallness_record,
-                          step_records, von_mises)
+from .postprocess import (
+    json_number,
+    pad_tensors,
+    pad_vectors,
+    smallness_record,
+    step_records,
+    von_mises,
+)
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 FACET_TYPES = {2: "line", 3: "triangle"}

@@ -16,8 +16,15 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 
-from .postprocess import (along_axis, beta_mean, facet_midpoints, normal_traction,  # noqa: E402
-                          tangent_direction, tangential_traction, von_mises)
+from .postprocess import (  # noqa: E402
+    along_axis,
+    beta_mean,
+    facet_midpoints,
+    normal_traction,
+    tangent_direction,
+    tangential_traction,
+    von_mises,
+)
 
 AXES = "xyz"
 DPI = 120

@@ -8,8 +8,16 @@ the references must not share code with what they check.
 
 import numpy as np
 import pytest
-from skfem import (Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm,
-                   MeshQuad, MeshTri, asm)
+from skfem import (
+    Basis,
+    ElementTriP1,
+    ElementVector,
+    FacetBasis,
+    LinearForm,
+    MeshQuad,
+    MeshTri,
+    asm,
+)
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from adhesive_contact import build_problem, parse_scene, solve

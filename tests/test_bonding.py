@@ -25,10 +25,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import reference_mesh, run, same_mesh
 
 from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
-
-from conftest import reference_mesh, run, same_mesh
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 

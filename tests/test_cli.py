@@ -8,10 +8,10 @@ from importlib import resources
 import meshio
 import numpy as np
 import pytest
+from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 
 from adhesive_contact import build_problem, parse_scene
-from adhesive_contact_cli.main import main
 
 # an 8x4 block hanging from its top, pulled down onto a wall with a gap that
 # is smallest in the middle: the wall becomes active at step 1 (7 nodes)

@@ -23,11 +23,17 @@ points of each facet with u_ν the P1 interpolant (Gauss rule).
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from conftest import (
+    clamped_dofs,
+    load_vector,
+    reference_mesh,
+    relative_max,
+    run,
+    same_mesh,
+    stiffness,
+)
 from scipy.optimize import minimize
 from skfem import ElementTriP1, FacetBasis, LinearForm, asm
-
-from conftest import (clamped_dofs, load_vector, reference_mesh, relative_max, run,
-                      same_mesh, stiffness)
 
 E, NU, C = 1000.0, 0.3, 2000.0
 SIZE, CELLS = (2.0, 0.5), (16, 8)

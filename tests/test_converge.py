@@ -7,14 +7,14 @@ import json
 import shutil
 from types import SimpleNamespace
 
+import adhesive_contact_cli.converge as converge_module
 import numpy as np
 import pytest
+from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 
-import adhesive_contact_cli.converge as converge_module
 from adhesive_contact import StepFailure, parse_scene
 from adhesive_contact.convergence import default_reference_refinement, run_reference
-from adhesive_contact_cli.main import main
 
 # no contact: u* is smooth and the library derives body force and tractions;
 # 8 steps keep the time error below the space error of the 3 levels

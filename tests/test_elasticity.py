@@ -5,12 +5,18 @@ and global equilibrium (forces and moment) of a contact run with memory.
 
 import numpy as np
 import pytest
-from scipy.sparse.linalg import spsolve
-from skfem import condense, solve as skfem_solve
+from conftest import (
+    clamped_dofs,
+    load_vector,
+    reference_mesh,
+    relative_max,
+    run,
+    same_mesh,
+    stiffness,
+)
+from skfem import condense
+from skfem import solve as skfem_solve
 from skfem.models.elasticity import lame_parameters
-
-from conftest import (clamped_dofs, load_vector, reference_mesh, relative_max, run,
-                      same_mesh, stiffness)
 
 E, NU = 1000.0, 0.3
 LAM, MU = lame_parameters(E, NU)  # plane strain: λ = Eν/((1+ν)(1−2ν)), μ = E/(2(1+ν))

@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from adhesive_contact import expressions
-from adhesive_contact.expressions import (Expression, ExpressionError,
-                                          compile_expression)
+from adhesive_contact.expressions import Expression, ExpressionError, compile_expression
 
 X = np.linspace(0.0, 2.0, 11)
 Y = np.linspace(-1.0, 1.0, 11)

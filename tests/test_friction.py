@@ -22,13 +22,19 @@ is used.
 
 import numpy as np
 import pytest
+from conftest import (
+    clamped_dofs,
+    load_vector,
+    reference_mesh,
+    relative_max,
+    run,
+    same_mesh,
+    stiffness,
+)
 from scipy.optimize import minimize
 from scipy.sparse.linalg import spsolve
 
 from adhesive_contact import StepFailure, build_problem, parse_scene, solve
-
-from conftest import (clamped_dofs, load_vector, reference_mesh, relative_max, run,
-                      same_mesh, stiffness)
 
 E, NU, C = 1000.0, 0.3, 1.0e4
 SIZE, CELLS = (2.0, 0.5), (16, 4)

@@ -21,12 +21,25 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from adhesive_contact.laws import (BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS,
-                                   AdhesiveCompliance, AdhesiveSpring, Fremond,
-                                   FrictionSum, NoNormalLaw, NormalCompliance,
-                                   PowerLaw, SlipWeakening, Tresca, make_bonding,
-                                   make_friction, make_normal_law, separation,
-                                   truncate)
+from adhesive_contact.laws import (
+    BONDING_LAWS,
+    FRICTION_LAWS,
+    NORMAL_LAWS,
+    AdhesiveCompliance,
+    AdhesiveSpring,
+    Fremond,
+    FrictionSum,
+    NoNormalLaw,
+    NormalCompliance,
+    PowerLaw,
+    SlipWeakening,
+    Tresca,
+    make_bonding,
+    make_friction,
+    make_normal_law,
+    separation,
+    truncate,
+)
 
 EPS = np.finfo(float).eps
 SLACK = 1e-12

@@ -6,13 +6,11 @@ equation (first order in k).
 
 import numpy as np
 import pytest
+from conftest import relative_max, run
 from scipy.integrate import quad
 
 from adhesive_contact import compile_expression
 from adhesive_contact.memory import FunctionMemory, PronyMemory
-
-from conftest import relative_max, run
-
 
 # --------------------------------------------------------------------------
 # The history sums
