@@ -67,7 +67,7 @@ def facet_parents(meshes, coarse_facets, fine_facets):
     the new midpoint vertex of its parent edge.
     """
     if meshes[0].dim() != 2:
-        raise NotImplementedError("facet parents are implemented for 2D meshes")
+        raise ValueError("facet parents (fine references) are implemented for 2D meshes only")
     parent = np.asarray(fine_facets)
     for coarse, fine in zip(meshes[-2::-1], meshes[:0:-1]):
         nc = coarse.p.shape[1]

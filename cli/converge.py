@@ -38,6 +38,7 @@ from pathlib import Path
 
 import click
 import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
+from matplotlib.ticker import NullFormatter  # noqa: E402
 import numpy as np
 
 from adhesive_contact import StepFailure, parse_scene
@@ -396,6 +397,7 @@ def plot_error_vs_size(path, document, title):
         ax.legend(fontsize="small", loc="best")
     else:
         ax.text(0.5, 0.5, "all errors are zero", transform=ax.transAxes, ha="center")
+    ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short axes
     ax.set_xlabel({"h": "mesh size h", "k": "time step k",
                    "hk": "mesh size h (time step k halved with h)"}[param])
     ax.set_ylabel("error, max over the time grid")
@@ -426,6 +428,7 @@ def plot_work_precision(path, document, title):
     if y.size or info["kind"] == "fine":
         ax.legend(fontsize="small", loc="best")
     ax.margins(x=0.12, y=0.15)   # room for the annotations
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("wall time of the level's run (s): assembly and time stepping")
     ax.set_ylabel("error E")
     ax.grid(True, which="both", color="0.9", linewidth=0.6)
@@ -500,6 +503,9 @@ def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, b
     if reference == "exact" and parsed.exact is None:
         raise CliError("--reference: 'exact' needs an [exact] table in the scene; "
                        "allowed here: fine", 2)
+    if reference == "fine" and parsed.dim == 3 and parsed.has_contact_terms:
+        raise CliError("--reference: 'fine' carries β between nested meshes in 2D only; "
+                       "allowed for this 3D scene: exact (add an [exact] table)", 2)
     if reference == "exact" and (ref_h is not None or ref_k is not None):
         raise CliError("--ref-h/--ref-k: refine the fine reference; allowed only with "
                        "--reference fine (the reference here is the exact solution)", 2)

@@ -471,3 +471,15 @@ def test_finished_study_rerun_with_jobs_computes_nothing(fine_study, tmp_path, s
     result = run(scenes.contact, "--param", "k", "--levels", 3, "--jobs", 2, "--out", out)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     assert counting.levels == [] and counting.reference == 0
+
+
+def test_fine_reference_in_3d_with_contact_exits_2(tmp_path):
+    text = (CONTACT_SCENE.replace("dim = 2", "dim = 3").replace('"rectangle"', '"box"')
+            .replace("size = [1.0, 0.5]", "size = [1.0, 0.5, 0.5]")
+            .replace("cells = [4, 2]", "cells = [2, 1, 1]")
+            .replace('body = ["0", "-400*t"]', 'body = ["0", "-400*t", "0"]'))
+    path = tmp_path / "box.toml"
+    path.write_text(text)
+    result = run(path, "--param", "h", "--levels", 2, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "--reference: 'fine'")
+    assert not (tmp_path / "out").exists()
