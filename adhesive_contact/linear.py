@@ -37,6 +37,26 @@ class DirectSolver:
         return self.lu.solve(np.asarray(b, dtype=float))
 
 
+class ImplicitSchur:
+    """S = A_CC − A_CI A_II⁻¹ A_IC applied to vectors, never formed, with a
+    dense ``approximation`` of it (a nearby Schur complement) that the step
+    solver uses as preconditioner.
+
+    For the t = 0 problem of a scene with memory (A instead of A + k R(0)),
+    used once: forming S would cost one solve per contact unknown, a product
+    costs one, and preconditioned by the Schur complement of A + k R(0) (a
+    relative perturbation of size k R(0)/A) CG needs a few.
+    """
+
+    def __init__(self, A_CC, A_CI, A_IC, solver, approximation):
+        self.A_CC, self.A_CI, self.A_IC, self.solver = A_CC, A_CI, A_IC, solver
+        self.approximation = approximation
+        self.shape = approximation.shape
+
+    def __matmul__(self, z):
+        return self.A_CC @ z - self.A_CI @ self.solver.solve(self.A_IC @ z)
+
+
 class CondensedOperator:
     """A step matrix on the free dofs, condensed onto the contact unknowns.
 
@@ -49,9 +69,12 @@ class CondensedOperator:
     chunk : int
         Right-hand sides per block solve when forming S (SuperLU's block
         solve is fastest per column for a few columns at a time).
+    approximation : dense (nC, nC), optional
+        A nearby Schur complement: then S is not formed but applied
+        (:class:`ImplicitSchur`), for an operator used for one step only.
     """
 
-    def __init__(self, A, contact, chunk=16):
+    def __init__(self, A, contact, chunk=16, approximation=None):
         t0 = time.perf_counter()
         n = A.shape[0]
         self.contact = np.asarray(contact, dtype=np.int64)
@@ -67,6 +90,12 @@ class CondensedOperator:
 
         t0 = time.perf_counter()
         nC = self.contact.size
+        if approximation is not None:
+            # S is applied, not formed: one solve pair per product
+            self.S = ImplicitSchur(A[self.contact][:, self.contact].tocsr(), self.A_CI,
+                                   self.A_IC, self.solver, approximation)
+            self.schur_seconds = time.perf_counter() - t0
+            return
         S = A[self.contact][:, self.contact].toarray()
         for start in range(0, nC, chunk):
             cols = slice(start, min(start + chunk, nC))

@@ -67,13 +67,48 @@ class Kink:
 def _solve_free(H, rhs, free):
     """Solve H_FF d = rhs; a modified Cholesky (|eigenvalues|, floored) when
     H_FF is not positive definite."""
-    HF = H[np.ix_(free, free)]
+    return _factor(H[np.ix_(free, free)])(rhs)
+
+
+def _factor(HF):
+    """A solver for the dense symmetric HF: Cholesky, or |eigenvalues| floored."""
     try:
-        return la.cho_solve(la.cho_factor(HF, check_finite=False), rhs, check_finite=False)
+        factor = la.cho_factor(HF, check_finite=False)
+        return lambda rhs: la.cho_solve(factor, rhs, check_finite=False)
     except la.LinAlgError:
         vals, vecs = la.eigh(HF)
-        floor = 1e-8 * max(np.abs(vals).max(), 1e-300)
-        return vecs @ ((vecs.T @ rhs) / np.maximum(np.abs(vals), floor))
+        vals = np.maximum(np.abs(vals), 1e-8 * max(np.abs(vals).max(), 1e-300))
+        return lambda rhs: vecs @ ((vecs.T @ rhs) / vals)
+
+
+def _solve_free_implicit(S, Hphi, rhs, free, tol=1e-12, max_iter=100):
+    """Solve (S + Hphi)_FF d = rhs by CG with S applied (ImplicitSchur),
+    preconditioned by (S.approximation + Hphi)_FF."""
+    Hphi_FF = Hphi[np.ix_(free, free)]
+    precondition = _factor(S.approximation[np.ix_(free, free)] + Hphi_FF)
+    full = np.zeros(S.shape[0])
+
+    def apply(v):
+        full[free] = v
+        return (S @ full)[free] + Hphi_FF @ v
+
+    d = np.zeros(rhs.size)
+    r = rhs.copy()
+    z = precondition(r)
+    p = z.copy()
+    rz = r @ z
+    stop = tol * np.linalg.norm(rhs)
+    for _ in range(max_iter):
+        if np.linalg.norm(r) <= stop:
+            break
+        Ap = apply(p)
+        alpha = rz / (p @ Ap)
+        d += alpha * p
+        r -= alpha * Ap
+        z = precondition(r)
+        rz, rz_old = r @ z, rz
+        p = z + (rz / rz_old) * p
+    return d
 
 
 def _blocks(v, idx):
@@ -85,7 +120,9 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
 
     Parameters
     ----------
-    S : (nz, nz) dense symmetric positive definite
+    S : (nz, nz) dense symmetric positive definite, or an ImplicitSchur
+        (applied only; Newton systems then by CG preconditioned with its
+        dense approximation)
     c : (nz,)
     energy : ContactEnergy
     upper : (nz,) bounds, +inf where there is none
@@ -108,7 +145,9 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
 
     z = np.minimum(z0, upper)
     E = total(z)
-    diag_S = np.maximum(np.diag(S), 1e-300) if nz else np.zeros(0)
+    implicit = hasattr(S, "approximation")
+    dense_S = S.approximation if implicit else S
+    diag_S = np.maximum(np.diag(dense_S), 1e-300) if nz else np.zeros(0)
     residual, scale = np.inf, 1.0
     stuck = np.zeros(kappa.size, dtype=bool)
     for it in range(max_iter + 1):
@@ -148,13 +187,16 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         if tan.size:
             fixed[tan[stuck]] = True
             d[tan[stuck]] = -xi[stuck]
-        H = S.copy()
         zmax = np.abs(z).max(initial=0.0)
-        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)
-        H += Hphi.toarray()
+        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax).toarray()
         d[binding] = upper[binding] - z[binding]   # onto the wall
         free = ~fixed
-        if free.any():
+        if free.any() and implicit:
+            rhs = -pg[free] - ((S @ np.where(fixed, d, 0.0))[free]
+                               + Hphi[np.ix_(free, fixed)] @ d[fixed])
+            d[free] = _solve_free_implicit(S, Hphi, rhs, np.flatnonzero(free))
+        elif free.any():
+            H = S + Hphi
             rhs = -pg[free] - H[np.ix_(free, fixed)] @ d[fixed]
             d[free] = _solve_free(H, rhs, free)
 

@@ -122,17 +122,19 @@ def _solve(problem, progress):
     # the system in nodal frames at Γ_C: ũ = Rᵀ u
     R = boundary.rotation(asm.ndofs) if boundary is not None else None
 
-    def condensed(lam_, mu_):
+    def condensed(lam_, mu_, approximation=None):
         A = asm.stiffness(lam_, mu_)
         if R is not None:
             A = (R.T @ A @ R).tocsr()
-        return CondensedOperator(A[free][:, free], problem.contact_positions)
+        return CondensedOperator(A[free][:, free], problem.contact_positions,
+                                 approximation=approximation)
 
-    # the step matrices: A at t = 0, a_n = A + k R(0) for n >= 1
+    # the step matrices: a_n = A + k R(0) for n >= 1, and A at t = 0; the
+    # latter serves one step, so its Schur complement is applied, not formed
     lam, mu = scene.material.lam, scene.material.mu
     dlam, dmu = memory.instantaneous(k)
-    op0 = condensed(lam, mu)
-    op = op0 if (dlam, dmu) == (0.0, 0.0) else condensed(lam + dlam, mu + dmu)
+    op = condensed(lam + dlam, mu + dmu)
+    op0 = op if (dlam, dmu) == (0.0, 0.0) else condensed(lam, mu, approximation=op.S)
     t_factor = time.perf_counter() - t_start
 
     npoints, ncells = problem.mesh.p.shape[1], problem.mesh.t.shape[1]
