@@ -451,6 +451,25 @@ def write_results(out, document, title):
 
 # ---------------------------------------------------------------- the command
 
+#: the largest run a study may ask for (dofs); beyond it the set-up alone
+#: (a Schur complement onto Γ_C) takes hours and tens of GB on this class
+#: of machine (studies/README.md, Cost)
+MAX_DOFS = 2_000_000
+
+
+def check_size(scene, problem, param, levels, reference, ref_h, ref_k, base_refine):
+    """Refuse (exit 2) a study whose finest level or reference is too large."""
+    growth = 2 ** scene.dim            # dofs per uniform refinement
+    base = problem.ndofs * growth ** ((base_refine or scene.mesh.refine) - scene.mesh.refine)
+    extra = (levels - 1 if param in ("h", "hk") else 0) + (ref_h if reference == "fine" else 0)
+    largest = base * growth ** extra
+    if largest > MAX_DOFS:
+        what = "the fine reference" if reference == "fine" and ref_h else "the finest level"
+        raise CliError(f"--levels: {what} would have about {largest:.2g} dofs (more than "
+                       f"{MAX_DOFS:.0e}); use fewer --levels, a smaller --ref-h, or a coarser "
+                       "mesh for level 0", 2)
+
+
 
 @click.command()
 @click.argument("scene", type=click.Path(dir_okay=False, path_type=Path))
@@ -513,6 +532,7 @@ def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, b
         dh, dk = default_reference_refinement(param)
         ref_h = dh if ref_h is None else ref_h
         ref_k = dk if ref_k is None else ref_k
+    check_size(parsed, problem, param, levels, reference, ref_h, ref_k, base_refine)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-converge-{param}"
     study = study_document(parsed, param, levels, reference, ref_h, ref_k)
     resume = open_study(out, study)
