@@ -38,8 +38,8 @@ from pathlib import Path
 
 import click
 import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
-from matplotlib.ticker import NullFormatter  # noqa: E402
 import numpy as np
+from matplotlib.ticker import NullFormatter  # noqa: E402
 
 from adhesive_contact import StepFailure, parse_scene
 from adhesive_contact.convergence import (

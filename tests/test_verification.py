@@ -8,11 +8,16 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementTriP1
 
-from adhesive_contact import build_problem, parse_scene, solve
+from adhesive_contact import build_problem, parse_scene
 from adhesive_contact.assembly import stiffness_basis, strain_map
 from adhesive_contact.convergence import rates, run_level, run_reference
-from adhesive_contact.verification import (cell_volumes, facet_parents, nested_meshes,
-                                           prolongation, strain_error_fine)
+from adhesive_contact.verification import (
+    cell_volumes,
+    facet_parents,
+    nested_meshes,
+    prolongation,
+    strain_error_fine,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = sorted((ROOT / "studies" / "convergence").glob("[a-d]_*.toml"))
