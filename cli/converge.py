@@ -401,6 +401,11 @@ def plot_error_vs_size(path, document, title):
     ax.set_xlabel({"h": "mesh size h", "k": "time step k",
                    "hk": "mesh size h (time step k halved with h)"}[param])
     ax.set_ylabel("error, max over the time grid")
+    _save(fig, ax, path, document, title)
+
+
+def _save(fig, ax, path, document, title):
+    """Grid, titles, and the PNG written atomically."""
     ax.grid(True, which="both", color="0.9", linewidth=0.6)
     _suptitle(fig, document, title)
     write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI, bbox_inches="tight"),
@@ -431,11 +436,7 @@ def plot_work_precision(path, document, title):
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("wall time of the level's run (s): assembly and time stepping")
     ax.set_ylabel("error E")
-    ax.grid(True, which="both", color="0.9", linewidth=0.6)
-    _suptitle(fig, document, title)
-    write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI, bbox_inches="tight"),
-                 binary=True)
-    plt.close(fig)
+    _save(fig, ax, path, document, title)
 
 
 def write_results(out, document, title):
