@@ -169,8 +169,7 @@ class Assembly:
         return (self.strain @ u).reshape(-1, self.dim, self.dim)
 
     def cell_stress(self, lam_field, mu_field):
-        """σ = tr ε(a) I + 2 ε(b) per cell (ncells, d, d)."""
-        ea = self.cell_strain(lam_field)
-        eb = self.cell_strain(mu_field)
-        tr = np.trace(ea, axis1=1, axis2=2)
-        return tr[:, None, None] * np.eye(self.dim) + 2.0 * eb
+        """σ = tr ε(a) I + 2 ε(b) per cell (ncells, d, d), and tr ε(a) (ncells,):
+        in plane strain (ε_zz = 0) the latter is σ_zz."""
+        tr = np.trace(self.cell_strain(lam_field), axis1=1, axis2=2)
+        return tr[:, None, None] * np.eye(self.dim) + 2.0 * self.cell_strain(mu_field), tr

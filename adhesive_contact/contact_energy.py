@@ -18,7 +18,8 @@ import scipy.sparse as sp
 
 
 class ContactEnergy:
-    """Φ for one step: the laws, β_n and the traces on the step's unknowns.
+    """Φ on the step's unknowns: the laws and the traces, built once per run;
+    β_n is set per step with :meth:`set_bonding`.
 
     Parameters
     ----------
@@ -26,18 +27,23 @@ class ContactEnergy:
     columns : (nz,) which of the full nodal-frame unknowns (nc·d, node-major)
         the step solves for
     normal_law, friction : laws (friction a FrictionSum or None)
-    beta : (nf,) β_n per contact facet
+    beta : (nf,) β per contact facet
     """
 
     def __init__(self, boundary, columns, normal_law, friction, beta):
+        self.boundary = boundary
         self.w = boundary.weights
         self.N = boundary.normal_trace[:, columns].tocsr()
         self.normal_law = normal_law
         self.friction = friction
-        self.beta = boundary.at_points(beta)
         self.T = ([t[:, columns].tocsr() for t in boundary.tangential_trace]
                   if friction is not None else [])
         self.nz = columns.size
+        self.set_bonding(beta)
+
+    def set_bonding(self, beta):
+        """Use β_n (nf,) per contact facet from now on."""
+        self.beta = self.boundary.at_points(beta)
 
     def _xi(self, z):
         return np.stack([t @ z for t in self.T], axis=-1)  # (nq, d−1)

@@ -160,6 +160,8 @@ def _solve(problem, progress):
         tangential = np.arange(problem.columns.size).reshape(nc, d)[:, 1:]
         kink = Kink(tangential, np.zeros(nc))
     contact_dofs = None if boundary is None else boundary.dofs.ravel()
+    energy = None if boundary is None else ContactEnergy(
+        boundary, problem.columns, problem.normal_law, problem.friction, problem.beta0)
 
     memory.begin(k, asm.ndofs)
     z = np.zeros(problem.columns.size)
@@ -182,8 +184,7 @@ def _solve(problem, progress):
         b = f[free]
         c = step.reduce(b)
         if boundary is not None:
-            energy = ContactEnergy(boundary, problem.columns, problem.normal_law,
-                                   problem.friction, beta_n)
+            energy.set_bonding(beta_n)
             if kink is not None:
                 kink.radius = energy.node_kink(boundary.point_node, nc)
             result = minimise_step(step.S, c, energy, problem.upper_bound(n), z,
@@ -210,10 +211,9 @@ def _solve(problem, progress):
         a_lam, a_mu = il * u, im * u
         if history is not None:
             a_lam, a_mu = a_lam + history[0], a_mu + history[1]
-        stress[n] = asm.cell_stress(a_lam, a_mu)
+        stress[n], zz = asm.cell_stress(a_lam, a_mu)
         if stress_zz is not None:
-            # ε_zz = 0 in plane strain: σ_zz = λ tr ε (+ the memory's λ parts)
-            stress_zz[n] = np.trace(asm.cell_strain(a_lam), axis1=1, axis2=2)
+            stress_zz[n] = zz
         if nprobes:
             probes[n] = problem.probe_map @ U[n]
         if n >= 1:
