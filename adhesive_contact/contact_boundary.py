@@ -77,6 +77,13 @@ def reference_facet_rule(dim, quadrature, order):
     return shapes, W / W.sum()
 
 
+def facet_points(mesh, facet_nodes, quadrature="gauss", order=4):
+    """Points (d, nf, nq) of a facet rule on the facets with vertices
+    ``facet_nodes`` (d, nf), and its weights (nq,) for the facet mean."""
+    shapes, weights = reference_facet_rule(mesh.dim(), quadrature, order)
+    return np.einsum("qv,dvf->dfq", shapes, mesh.p[:, facet_nodes]), weights
+
+
 @dataclass
 class ContactBoundary:
     """Γ_C of a mesh, with its contact unknowns and its quadrature.
@@ -168,12 +175,12 @@ def build_contact_boundary(mesh, contact_facets, clamped_nodes, quadrature="noda
     dofs = np.stack([d * nodes + c for c in range(d)], axis=1)  # interleaved dofs
 
     shapes, ref_weights = reference_facet_rule(d, quadrature, order)
+    points, _ = facet_points(mesh, facet_nodes, quadrature, order)
     nq_ref = ref_weights.size
     nf = facets.size
     weights = (measure[:, None] * ref_weights[None, :]).ravel()
     facet_of_point = np.repeat(np.arange(nf), nq_ref)
-    points = np.einsum("qv,dfv->dfq", shapes, mesh.p[:, facet_nodes].transpose(0, 2, 1)
-                       ).reshape(d, -1)
+    points = points.reshape(d, -1)
 
     # nodal: point (f, v) reads node facet_nodes[v, f] in its own frame;
     # gauss: the point reads the P1 interpolant in the facet's frame

@@ -18,7 +18,7 @@ from .assembly import Assembly, LoadMap, is_zero, vector_of
 from .contact_boundary import (
     build_contact_boundary,
     facet_normals,
-    reference_facet_rule,
+    facet_points,
     tangent_frame,
 )
 from .expressions import coordinates
@@ -95,10 +95,8 @@ class Problem:
 
 def _facet_mean(mesh, boundary, expr, order=4):
     """P_B of an expression: its mean over each contact facet (Gauss rule)."""
-    d = mesh.dim()
-    shapes, weights = reference_facet_rule(d, "gauss", order)
-    x = np.einsum("qv,dvf->dfq", shapes, mesh.p[:, boundary.facet_nodes])
-    values = expr(*coordinates(x.reshape(d, -1))).reshape(x.shape[1:])
+    x, weights = facet_points(mesh, boundary.facet_nodes, "gauss", order)
+    values = expr(*coordinates(x.reshape(mesh.dim(), -1))).reshape(x.shape[1:])
     return values @ weights
 
 

@@ -25,7 +25,7 @@ from skfem import Basis
 from skfem.quadrature import get_quadrature
 
 from .assembly import vector_element
-from .contact_boundary import reference_facet_rule
+from .contact_boundary import facet_points
 from .expressions import coordinates
 from .mesh import build_mesh
 
@@ -114,8 +114,8 @@ class ExactErrors:
         self.boundary = problem.boundary
         self.beta_of = beta
         if problem.boundary is not None and beta is not None:
-            shapes, weights = reference_facet_rule(d, "gauss", facet_order)
-            pts = np.einsum("qv,dvf->dfq", shapes, mesh.p[:, problem.boundary.facet_nodes])
+            pts, weights = facet_points(mesh, problem.boundary.facet_nodes, "gauss",
+                                        facet_order)
             self.facet_x = pts                                      # (d, nf, nq)
             self.facet_w = problem.boundary.measure[:, None] * weights[None, :]
 
