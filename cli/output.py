@@ -30,10 +30,10 @@ import numpy as np
 from . import plots
 from .postprocess import (
     json_number,
-    pad_tensors,
     pad_vectors,
     smallness_record,
     step_records,
+    stress_3x3,
     von_mises,
 )
 
@@ -133,8 +133,8 @@ def write_xdmf(solution, folder):
             writer.write_data(
                 float(t),
                 point_data={"u": pad_vectors(solution.u[n])},
-                cell_data={"stress": [pad_tensors(solution.stress[n])],
-                           "von_mises": [von_mises(solution.stress[n])]})
+                cell_data={"stress": [stress_3x3(solution, n).reshape(-1, 9)],
+                           "von_mises": [von_mises(stress_3x3(solution, n))]})
     if problem.boundary is not None and problem.boundary.facets.size:
         names += ["contact.xdmf"] + ["contact.h5"] * h5
         with _XdmfSeriesWriter(Path(folder) / "contact.xdmf", fmt) as writer:

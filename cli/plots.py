@@ -21,6 +21,7 @@ from .postprocess import (  # noqa: E402
     beta_mean,
     facet_midpoints,
     normal_traction,
+    stress_3x3,
     tangent_direction,
     tangential_traction,
     von_mises,
@@ -60,7 +61,7 @@ def _title(solution):
 def _deformed_2d(fig, ax, solution, factor):
     mesh = solution.problem.mesh
     p = mesh.p + factor * solution.u[-1].T
-    vm = von_mises(solution.stress[-1])
+    vm = von_mises(stress_3x3(solution, -1))
     tri = Triangulation(p[0], p[1], mesh.t.T)
     image = ax.tripcolor(tri, facecolors=vm, cmap="viridis", shading="flat")
     ax.triplot(tri, color="k", linewidth=0.2, alpha=0.4)
@@ -88,7 +89,7 @@ def _deformed_3d(fig, solution, factor):
     ax = fig.add_subplot(projection="3d")
     p = mesh.p + factor * solution.u[-1].T
     faces = mesh.boundary_facets()
-    vm = von_mises(solution.stress[-1])[mesh.f2t[0, faces]]
+    vm = von_mises(stress_3x3(solution, -1))[mesh.f2t[0, faces]]
     norm = plt.Normalize(vm.min(), vm.max())
     polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
     ax.add_collection3d(Poly3DCollection(polys, facecolors=plt.cm.viridis(norm(vm)),

@@ -11,26 +11,22 @@ import math
 import numpy as np
 
 
+def stress_3x3(solution, n):
+    """σ_n per cell as full 3 × 3 tensors (ncells, 3, 3): in plane strain the
+    zz entry is the solution's σ_zz (λ tr ε with the memory's λ parts)."""
+    s = solution.stress[n]
+    if s.shape[-1] == 3:
+        return s
+    full = np.zeros(s.shape[:-2] + (3, 3))
+    full[..., :2, :2] = s
+    full[..., 2, 2] = solution.stress_zz[n]
+    return full
+
+
 def von_mises(stress):
-    """Von Mises equivalent stress of symmetric tensors.
-
-    Parameters
-    ----------
-    stress : (..., d, d) array, d = 2 or 3
-
-    Returns
-    -------
-    (...) array.
-        d = 3: sqrt(3/2 s:s) with s the deviator of σ.
-        d = 2: the plane-stress form sqrt(σxx² − σxx σyy + σyy² + 3 σxy²) of
-        the in-plane tensor. In plane strain σ_zz ≠ 0 but the solution does
-        not carry it (with memory it is not λ tr ε alone), so it is left out:
-        a plotting measure, not the full 3D invariant.
-    """
+    """Von Mises equivalent stress sqrt(3/2 s:s), s the deviator of the
+    3 × 3 tensors ``stress`` (..., 3, 3) (see :func:`stress_3x3`)."""
     s = np.asarray(stress)
-    if s.shape[-1] == 2:
-        sxx, syy, sxy = s[..., 0, 0], s[..., 1, 1], s[..., 0, 1]
-        return np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2, 0.0))
     dev = s - np.trace(s, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3.0
     return np.sqrt(1.5 * np.einsum("...ij,...ij->...", dev, dev))
 
@@ -40,17 +36,6 @@ def pad_vectors(v):
     v = np.asarray(v, dtype=float)
     pad = [(0, 0)] * (v.ndim - 1) + [(0, 3 - v.shape[-1])]
     return np.pad(v, pad)
-
-
-def pad_tensors(t):
-    """Tensors (..., d, d) padded with zeros to 3×3 and flattened to (..., 9).
-
-    In 2D the zz component is 0 (see :func:`von_mises`)."""
-    t = np.asarray(t, dtype=float)
-    d = t.shape[-1]
-    pad = [(0, 0)] * (t.ndim - 2) + [(0, 3 - d), (0, 3 - d)]
-    padded = np.pad(t, pad)
-    return padded.reshape(*padded.shape[:-2], 9)
 
 
 def normal_traction(solution):

@@ -185,6 +185,13 @@ def test_xdmf_reads_back_as_a_time_series(solved):
     assert cell_data["stress"][0].shape == (NCELLS, 9)
     assert cell_data["von_mises"][0].shape == (NCELLS,)
     assert np.all(cell_data["von_mises"][0] >= 0) and cell_data["von_mises"][0].max() > 0
+    # plane strain, ν = 0.3 in the material and the memory: σ_zz = ν (σ_xx + σ_yy)
+    sig = cell_data["stress"][0].reshape(-1, 3, 3)
+    np.testing.assert_allclose(sig[:, 2, 2], 0.3 * (sig[:, 0, 0] + sig[:, 1, 1]),
+                               rtol=0, atol=1e-12 * np.abs(sig).max())
+    dev = sig - np.trace(sig, axis1=1, axis2=2)[:, None, None] * np.eye(3) / 3
+    np.testing.assert_allclose(cell_data["von_mises"][0],
+                               np.sqrt(1.5 * np.sum(dev * dev, axis=(1, 2))), rtol=1e-12)
 
     contact = meshio.xdmf.TimeSeriesReader(out / "contact.xdmf")
     _, facet_cells = contact.read_points_cells()
