@@ -30,7 +30,7 @@ class NoMemory:
         return 0.0, 0.0
 
     def begin(self, k, ndofs):
-        self.ndofs = ndofs
+        pass
 
     def history(self, n):
         """(a_λ, a_μ) of the history at step n, or None when it is zero."""
