@@ -4,12 +4,14 @@ Exit codes: 0 success; 2 a bad scene or bad arguments; 1 a solver that
 did not converge (or outputs that could not be written). Every error is
 one line ``error: ...`` on stderr, and nothing is written to the output
 folder: the scene is parsed, the problem built and the scheme run before
-any file is created, and the folder itself appears atomically. What the
+any file is created, and the outputs appear atomically (a new folder in
+one rename; into an existing one file by file, touching no other file). What the
 theory does not cover for a valid scene (``Problem.warnings()``) is
 reported as one line ``warning: ...`` each on stderr before the time loop,
 and the run goes on.
 """
 
+import os
 import sys
 from pathlib import Path
 
@@ -51,17 +53,16 @@ class OneLineGroup(click.Group):
 
 
 def check_out(out):
-    """Refuse (exit 2) an ``--out`` that must not be replaced.
+    """Refuse (exit 2) an ``--out`` that cannot take the outputs, before the solve.
 
-    An existing folder is replaced only if it is empty or holds a previous
-    run's ``summary.json``: ``--out .`` or ``--out ~`` must not wipe a folder
-    of other files."""
+    An existing folder is fine: only the run's own files are replaced in it
+    (:func:`~.output.write_outputs`), a user's other files stay."""
     if out.exists() and not out.is_dir():
         raise CliError(f"--out: {str(out)!r} exists and is not a folder", 2)
-    if out.is_dir() and any(out.iterdir()) and not (out / "summary.json").is_file():
-        raise CliError(f"--out: {str(out)!r} is a non-empty folder that is not an "
-                       "adhcontact output (no summary.json); it would be replaced: "
-                       "choose another folder", 2)
+    existing = next(p for p in [out.absolute(), *out.absolute().parents] if p.exists())
+    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
+        raise CliError(f"--out: {str(out)!r} cannot be written ({str(existing)!r} is not "
+                       "a writable folder)", 2)
 
 
 @click.group(cls=OneLineGroup)
@@ -74,7 +75,7 @@ def main():
 @click.argument("scene", required=False,
                 type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
-              help="Output folder (replaced if it exists). "
+              help="Output folder; in an existing one only the run's own files are replaced. "
                    "Default: ./<scene file stem>, ./default for the built-in scene.")
 def solve(scene, out):
     """Run SCENE (a TOML file; the built-in default scene if omitted).

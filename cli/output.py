@@ -1,8 +1,8 @@
 """The output folder of ``adhcontact solve`` (SPEC.md, "Command line").
 
-:func:`write_outputs` writes every file into a temporary sibling folder
-``DIR.tmp-XXXX`` and then moves it into place, so a reader never sees a
-half-written ``DIR``:
+:func:`write_outputs` writes every file into a temporary folder and then
+moves it into place (:func:`_publish`), so a reader never sees a
+half-written ``DIR`` and a user's own files in ``DIR`` are never touched:
 
 - ``summary.json``: resolved scene, mesh counts, the smallness terms of
   MODEL.md §2 (null without contact), the warnings of the problem, timings,
@@ -145,23 +145,33 @@ def write_xdmf(solution, folder):
     return names
 
 
-def _replace_folder(new, target):
-    """Move folder ``new`` to ``target``, replacing an existing ``target``.
+#: every file name ``adhcontact solve`` may write; in an existing folder a
+#: run replaces these and touches nothing else
+OUTPUT_NAMES = frozenset(
+    ["summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
+     "contact.h5"] + [f"{name}.png" for name in plots.PLOT_NAMES])
 
-    The old folder is renamed away first and deleted only once the new one
-    is in place (and renamed back if that fails)."""
+
+def _publish(staging, target):
+    """Move the files of folder ``staging`` into ``target``.
+
+    A new ``target`` is ``staging`` renamed, in one step. Into an existing
+    folder the files are moved one by one with :func:`os.replace` (each
+    atomic), ``summary.json`` last and the previous ``summary.json`` removed
+    first, so a folder with a ``summary.json`` always holds one whole run;
+    outputs of a previous run that this run does not write are removed;
+    any other file in ``target`` is left alone."""
     if not target.exists():
-        os.rename(new, target)
+        os.chmod(staging, 0o755)  # mkdtemp makes it private
+        os.rename(staging, target)
         return
-    graveyard = Path(tempfile.mkdtemp(prefix=f"{target.name}.old-", dir=target.parent))
-    old = graveyard / target.name
-    os.rename(target, old)
-    try:
-        os.rename(new, target)
-    except BaseException:
-        os.rename(old, target)
-        raise
-    shutil.rmtree(graveyard, ignore_errors=True)
+    names = {p.name for p in staging.iterdir()}
+    (target / "summary.json").unlink(missing_ok=True)
+    for name in sorted(names - {"summary.json"}) + ["summary.json"]:
+        os.replace(staging / name, target / name)
+    for name in OUTPUT_NAMES - names:
+        (target / name).unlink(missing_ok=True)
+    staging.rmdir()
 
 
 def write_outputs(solution, out):
@@ -170,24 +180,27 @@ def write_outputs(solution, out):
     Parameters
     ----------
     solution : adhesive_contact.Solution
-    out : path of the output folder; its parents are created, an existing
-        folder is replaced.
+    out : path of the output folder; its parents are created. In an
+        existing folder only the files of :data:`OUTPUT_NAMES` are replaced
+        (see :func:`_publish`); a user's other files stay.
 
     Returns
     -------
     list of str : the names of the files written, sorted.
     """
     out = Path(out).absolute()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-", dir=out.parent))
+    if out.is_dir():   # staged inside, so that os.replace stays on one file system
+        tmp = Path(tempfile.mkdtemp(prefix=".adhcontact.tmp-", dir=out))
+    else:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-", dir=out.parent))
     try:
         write_summary(solution, tmp / "summary.json")
         write_npz(solution, tmp / "solution.npz")
         write_xdmf(solution, tmp)
         plots.write_plots(solution, tmp)
-        os.chmod(tmp, 0o755)  # mkdtemp makes it private
         names = sorted(p.name for p in tmp.iterdir())
-        _replace_folder(tmp, out)
+        _publish(tmp, out)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

@@ -325,6 +325,10 @@ def plot_beta(solution, path):
     plt.close(fig)
 
 
+#: the figures :func:`write_plots` may draw, without the ``.png``
+PLOT_NAMES = ("deformed", "contact_traction", "beta")
+
+
 def write_plots(solution, folder):
     """Draw the figures into ``folder``; return the names of the files written.
 

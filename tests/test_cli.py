@@ -228,24 +228,57 @@ def test_default_out_is_named_after_the_scene(tmp_path, monkeypatch):
     assert set(p.name for p in (tmp_path / "wall_case").iterdir()) == FILES
 
 
-def test_existing_out_is_replaced(tmp_path):
+def test_existing_out_keeps_the_users_files(tmp_path):
     (tmp_path / "scene.toml").write_text(SCENE)
     out = tmp_path / "out"
     out.mkdir()
     (out / "summary.json").write_text("{}")   # a previous run's output
-    (out / "stale.txt").write_text("old")
+    (out / "notes.txt").write_text("mine")
     result = run("solve", tmp_path / "scene.toml", "--out", out)
     assert result.exit_code == 0, result.stderr
-    assert set(p.name for p in out.iterdir()) == FILES
+    assert set(p.name for p in out.iterdir()) == FILES | {"notes.txt"}
+    assert (out / "notes.txt").read_text() == "mine"
+    assert strict_json(out / "summary.json")["steps"]   # replaced by this run's
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "scene.toml"]
 
 
-def test_out_folder_of_other_files_is_not_replaced(tmp_path, monkeypatch):
+def test_out_dot_in_a_folder_of_scene_and_notes_loses_nothing(tmp_path, monkeypatch):
+    # the data-loss defect: a folder holding a scene, notes and a summary.json
+    # was replaced whole by ``--out .``, deleting the scene and the notes
     monkeypatch.chdir(tmp_path)
     (tmp_path / "scene.toml").write_text(SCENE)
-    result = run("solve", "scene.toml", "--out", ".")
+    (tmp_path / "notes.txt").write_text("my notes")
+    (tmp_path / "summary.json").write_text("{}")
+    for _ in range(2):   # a second run into the same folder as well
+        result = run("solve", "scene.toml", "--out", ".")
+        assert result.exit_code == 0, result.stderr
+        assert (tmp_path / "scene.toml").read_text() == SCENE
+        assert (tmp_path / "notes.txt").read_text() == "my notes"
+        assert set(p.name for p in tmp_path.iterdir()) == FILES | {"scene.toml", "notes.txt"}
+
+
+def test_stale_outputs_of_a_previous_run_are_removed(tmp_path):
+    # a run with contact, then one without, into the same folder: the
+    # contact files of the first must not pass for the second's
+    out = tmp_path / "out"
+    (tmp_path / "scene.toml").write_text(SCENE)
+    assert run("solve", tmp_path / "scene.toml", "--out", out).exit_code == 0
+    no_contact = edit(SCENE, 'contact = ["bottom"]', "contact = []")
+    no_contact = no_contact[:no_contact.index("[contact]")] + no_contact[no_contact.index("[time]"):]
+    (tmp_path / "free.toml").write_text(no_contact)
+    result = run("solve", tmp_path / "free.toml", "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert set(p.name for p in out.iterdir()) == {"summary.json", "solution.npz",
+                                                  "solution.xdmf", "solution.h5",
+                                                  "deformed.png"}
+
+
+def test_out_that_is_a_file_is_refused_before_the_solve(tmp_path):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    (tmp_path / "taken").write_text("a file")
+    result = run("solve", tmp_path / "scene.toml", "--out", tmp_path / "taken")
     assert_one_line_error(result, 2, "--out")
-    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
+    assert (tmp_path / "taken").read_text() == "a file"
 
 
 def test_default_scene_runs_without_arguments(tmp_path):
