@@ -6,7 +6,7 @@ Euler bonding) on scikit-fem. See MODEL.md for the mathematics."""
 from .expressions import ExpressionError, compile_expression
 from .problem import Problem, build_problem
 from .scene import Scene, SceneError, parse_scene, scene_from_dict
-from .timestepping import Solution, StepFailure, solve
+from .scheme import Solution, StepFailure, solve
 
 __version__ = "0.1.0"
 

@@ -98,11 +98,15 @@ def strain_map(basis):
     return B
 
 
-def vector_of(expressions):
-    """A vector field f(x, y, z, t) -> (d, ...) from d scalar expressions."""
-    def f(x, y=None, z=None, t=0.0):
-        return np.stack([e(x, y, z, t=t) for e in expressions])
-    return f
+class vector_of:
+    """A vector field f(x, y, z, t) -> (d, ...) from d scalar expressions
+    (a class rather than a closure, so that a Problem pickles)."""
+
+    def __init__(self, expressions):
+        self.expressions = tuple(expressions)
+
+    def __call__(self, x, y=None, z=None, t=0.0):
+        return np.stack([e(x, y, z, t=t) for e in self.expressions])
 
 
 def is_zero(expressions):

@@ -26,7 +26,7 @@ from .assembly import stiffness_basis, strain_map
 from .contact_boundary import facet_normals
 from .mesh import mesh_size
 from .problem import build_problem
-from .timestepping import solve
+from .scheme import solve
 from .verification import (
     ExactErrors,
     facet_parents,
@@ -95,7 +95,7 @@ def run_reference(scene, param, levels, ref_h=None, ref_k=None, progress=None):
     ref = reference_scene(scene, param, levels, ref_h, ref_k)
     t0 = time.perf_counter()
     problem = build_problem(ref)
-    solution = solve(problem, progress)
+    solution = solve(problem, progress, raise_on_failure=True)
     facets = problem.boundary.facets if problem.boundary is not None else np.zeros(0, int)
     return Reference(ref, solution.t, solution.u, solution.beta, facets,
                      time.perf_counter() - t0)
@@ -153,7 +153,7 @@ def run_level(scene, param, level, reference=None, progress=None):
     lscene = level_scene(scene, param, level)
     t0 = time.perf_counter()
     problem = build_problem(lscene)
-    solution = solve(problem, progress)
+    solution = solve(problem, progress, raise_on_failure=True)
     seconds = time.perf_counter() - t0
     if reference is None:
         if problem.exact is None:

@@ -1,15 +1,16 @@
 """A scene made discrete: everything built once before the time loop.
 
 :func:`build_problem` turns a :class:`~adhesive_contact.scene.Scene` into
-a :class:`Problem`: the mesh and its per-mesh operators, the free and
-clamped dofs, Γ_C (only if the scene has contact terms), the load map, the
-gap at the contact nodes for every t_n, the initial bonding β_0^h = P_B β_0,
-the memory and the probes. Checks that need the geometry (a probe outside
+a :class:`Problem`: the mesh and its per-mesh operators, the free dofs,
+Γ_C (only if the scene has contact terms), the load map, the gap at the
+contact nodes for every t_n, the initial bonding β_0^h = P_B β_0, the laws
+and the probes. A Problem is never changed by a run: each run starts its
+own memory history (:meth:`Problem.start_memory`). Checks that need the geometry (a probe outside
 the mesh, a negative gap) raise :class:`~adhesive_contact.scene.SceneError`.
 """
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1
@@ -30,13 +31,19 @@ from .scene import SIDES, SceneError
 from .smallness import smallness
 
 
-@dataclass
+@dataclass(kw_only=True)
 class Problem:
+    """A discretised scene; built once, never changed by a run.
+
+    Absent concepts are None (``boundary``, ``gap``, ``friction``,
+    ``bonding``, ``probe_map``, ``exact``, ``beta_source``), except the
+    normal law, whose null object :class:`~adhesive_contact.laws.NoNormalLaw`
+    contributes nothing, and the memory (:class:`~adhesive_contact.memory.NoMemory`)."""
+
     scene: object
     mesh: object
     assembly: Assembly
-    free: np.ndarray          # free dofs
-    clamped: np.ndarray       # dofs on Γ_D
+    free: np.ndarray          # free dofs (not on Γ_D)
     boundary: object          # ContactBoundary, or None
     columns: np.ndarray       # the step's unknowns among the nc·d frame components
     contact_positions: np.ndarray  # positions of those unknowns within ``free``
@@ -46,13 +53,24 @@ class Problem:
     normal_law: object
     friction: object          # FrictionSum or None
     bonding: object           # bonding law or None (β frozen)
-    memory: object
     probe_map: object         # sparse (nprobes, npoints) or None
     times: np.ndarray         # t_n, n = 0..N
     assembly_seconds: float
-    smallness: dict = None    # the terms of MODEL.md §2's condition (with contact)
     exact: object = None      # ManufacturedSolution, for scenes with [exact]
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
+    _smallness: dict = field(default=None, repr=False)
+
+    def start_memory(self):
+        """A fresh memory history for one run (the rectangle rule's state)."""
+        return make_memory(self.scene.memory)
+
+    @property
+    def smallness(self):
+        """The terms of MODEL.md §2's condition (None without contact),
+        computed on first use (a generalised eigenproblem) and kept."""
+        if self._smallness is None and self.boundary is not None:
+            self._smallness = smallness(self.scene, self.normal_law, self.friction)
+        return self._smallness
 
     def warnings(self):
         """What the theory does not cover for this scene, one line each."""
@@ -110,8 +128,7 @@ def build_problem(scene):
 
     dirichlet_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
     clamped_nodes = np.unique(mesh.facets[:, dirichlet_facets])
-    clamped = np.sort(basis.nodal_dofs[:, clamped_nodes].ravel())
-    free = np.setdiff1d(np.arange(basis.N), clamped)
+    free = np.setdiff1d(np.arange(basis.N), basis.nodal_dofs[:, clamped_nodes].ravel())
     position = np.full(basis.N, -1)
     position[free] = np.arange(free.size)
 
@@ -185,10 +202,12 @@ def build_problem(scene):
             beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
             beta0 = _facet_mean(mesh, boundary, exact.beta)
     loads = LoadMap(mesh, body, surface)
-    small = smallness(scene, normal_law, friction) if boundary is not None else None
-    return Problem(scene, mesh, assembly, free, clamped, boundary, columns, contact_positions,
-                   loads, gap, beta0, normal_law, friction, bonding, make_memory(scene.memory),
-                   probe_map, times, time.perf_counter() - t0, small, exact, beta_source)
+    return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free, boundary=boundary,
+                   columns=columns, contact_positions=contact_positions, loads=loads, gap=gap,
+                   beta0=beta0, normal_law=normal_law, friction=friction, bonding=bonding,
+                   probe_map=probe_map, times=times,
+                   assembly_seconds=time.perf_counter() - t0, exact=exact,
+                   beta_source=beta_source)
 
 
 def _side_normal(side, d):

@@ -1,6 +1,6 @@
 """The nonsmooth step solve of (4.1) on the contact unknowns.
 
-With the interior condensed out (:mod:`adhesive_contact.linear`), a step
+With the interior condensed out (:mod:`adhesive_contact.scheme.condensed`), a step
 minimises the energy of MODEL.md §5 over the contact unknowns z,
 
     E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z_ν ≤ g  (the wall),
@@ -37,23 +37,39 @@ the step, and returns the wall multipliers λ = −∂_ν E ≥ 0 on the wall.
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as la
+
+#: StepResult.status: how a step solve ended
+CONVERGED, MAX_ITERATIONS, LINE_SEARCH_FAILED = 0, 1, 2
+MESSAGES = {CONVERGED: "converged",
+            MAX_ITERATIONS: "no convergence in {max_iter} iterations",
+            LINE_SEARCH_FAILED: "line search failed: no decrease of the energy along the "
+                                "Newton or the gradient direction"}
 
 
 @dataclass
 class StepResult:
-    """How a step solve ended (cf. scipy.optimize.OptimizeResult)."""
+    """How a step solve ended (cf. scipy.optimize.OptimizeResult).
+
+    ``status`` is one of :data:`CONVERGED`, :data:`MAX_ITERATIONS`,
+    :data:`LINE_SEARCH_FAILED`; ``residual`` the relative projected residual
+    reached; ``inner_failures`` the Newton systems whose iterative solve
+    (CG, for an applied Schur complement) stopped before its tolerance."""
 
     z: np.ndarray
-    success: bool
+    status: int
     message: str
     nit: int
     residual: float
     tolerance: float
     energy: float
-    multiplier: np.ndarray = field(repr=False)   # wall reaction λ ≥ 0 per unknown
-    on_wall: np.ndarray = field(repr=False)      # bool per unknown
-    stuck: np.ndarray = field(repr=False)        # bool per node with a kink (ξ_a = 0)
+    inner_failures: int = 0
+    multiplier: np.ndarray = field(default=None, repr=False)  # wall reaction λ ≥ 0 per unknown
+    on_wall: np.ndarray = field(default=None, repr=False)     # bool per unknown
+    stuck: np.ndarray = field(default=None, repr=False)       # bool per node with a kink (ξ_a = 0)
+
+    @property
+    def success(self):
+        return self.status == CONVERGED
 
 
 @dataclass
@@ -62,53 +78,6 @@ class Kink:
 
     tangential: np.ndarray   # (na, m) indices into z
     radius: np.ndarray       # (na,) κ_a ≥ 0
-
-
-def _solve_free(H, rhs, free):
-    """Solve H_FF d = rhs; a modified Cholesky (|eigenvalues|, floored) when
-    H_FF is not positive definite."""
-    return _factor(H[np.ix_(free, free)])(rhs)
-
-
-def _factor(HF):
-    """A solver for the dense symmetric HF: Cholesky, or |eigenvalues| floored."""
-    try:
-        factor = la.cho_factor(HF, check_finite=False)
-        return lambda rhs: la.cho_solve(factor, rhs, check_finite=False)
-    except la.LinAlgError:
-        vals, vecs = la.eigh(HF)
-        vals = np.maximum(np.abs(vals), 1e-8 * max(np.abs(vals).max(), 1e-300))
-        return lambda rhs: vecs @ ((vecs.T @ rhs) / vals)
-
-
-def _solve_free_implicit(S, Hphi, rhs, free, tol=1e-12, max_iter=100):
-    """Solve (S + Hphi)_FF d = rhs by CG with S applied (ImplicitSchur),
-    preconditioned by (S.approximation + Hphi)_FF."""
-    Hphi_FF = Hphi[np.ix_(free, free)]
-    precondition = _factor(S.approximation[np.ix_(free, free)] + Hphi_FF)
-    full = np.zeros(S.shape[0])
-
-    def apply(v):
-        full[free] = v
-        return (S @ full)[free] + Hphi_FF @ v
-
-    d = np.zeros(rhs.size)
-    r = rhs.copy()
-    z = precondition(r)
-    p = z.copy()
-    rz = r @ z
-    stop = tol * np.linalg.norm(rhs)
-    for _ in range(max_iter):
-        if np.linalg.norm(r) <= stop:
-            break
-        Ap = apply(p)
-        alpha = rz / (p @ Ap)
-        d += alpha * p
-        r -= alpha * Ap
-        z = precondition(r)
-        rz, rz_old = r @ z, rz
-        p = z + (rz / rz_old) * p
-    return d
 
 
 def _blocks(v, idx):
@@ -120,9 +89,10 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
 
     Parameters
     ----------
-    S : (nz, nz) dense symmetric positive definite, or an ImplicitSchur
-        (applied only; Newton systems then by CG preconditioned with its
-        dense approximation)
+    S : the condensed step matrix, a
+        :class:`~adhesive_contact.scheme.condensed.DenseSchur` or
+        :class:`~adhesive_contact.scheme.condensed.ImplicitSchur`
+        (``S @ z``, ``diagonal()``, ``newton_solve``)
     c : (nz,)
     energy : ContactEnergy
     upper : (nz,) bounds, +inf where there is none
@@ -145,11 +115,8 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
 
     z = np.minimum(z0, upper)
     E = total(z)
-    implicit = hasattr(S, "approximation")
-    dense_S = S.approximation if implicit else S
-    diag_S = np.maximum(np.diag(dense_S), 1e-300) if nz else np.zeros(0)
-    residual, scale = np.inf, 1.0
-    stuck = np.zeros(kappa.size, dtype=bool)
+    diag_S = np.maximum(S.diagonal(), 1e-300) if nz else np.zeros(0)
+    inner_failures = 0
     for it in range(max_iter + 1):
         Sz = S @ z
         gphi = energy.gradient(z)
@@ -171,17 +138,16 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         scale = max(np.abs(c).max(initial=0.0), np.abs(Sz).max(initial=0.0),
                     np.abs(gphi).max(initial=0.0), kappa.max(initial=0.0), 1e-300)
         residual = np.abs(pg).max(initial=0.0)
-        if residual <= tol * scale:
-            return StepResult(z, True, "converged", it, residual / scale, tol, E,
-                              np.where(wall, -g, 0.0), wall, at_zero)
-        if it == max_iter:
+        status = (CONVERGED if residual <= tol * scale else
+                  MAX_ITERATIONS if it == max_iter else None)
+        if status is not None:
             break
 
         # identify the sets with a projected-gradient step length ε
         width = np.abs(z - np.minimum(z - pg / np.where(diag_S > 0, diag_S, 1.0),
                                       upper)).max(initial=0.0)
         binding = bounded & (z >= upper - width) & (g < 0)
-        stuck = (s <= width) & (hn <= kappa) if tan.size else stuck
+        stuck = (s <= width) & (hn <= kappa)
         fixed = binding.copy()
         d = np.zeros(nz)
         if tan.size:
@@ -191,14 +157,11 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax).toarray()
         d[binding] = upper[binding] - z[binding]   # onto the wall
         free = ~fixed
-        if free.any() and implicit:
+        if free.any():
             rhs = -pg[free] - ((S @ np.where(fixed, d, 0.0))[free]
                                + Hphi[np.ix_(free, fixed)] @ d[fixed])
-            d[free] = _solve_free_implicit(S, Hphi, rhs, np.flatnonzero(free))
-        elif free.any():
-            H = S + Hphi
-            rhs = -pg[free] - H[np.ix_(free, fixed)] @ d[fixed]
-            d[free] = _solve_free(H, rhs, free)
+            d[free], converged = S.newton_solve(Hphi, rhs, free)
+            inner_failures += not converged
 
         # slipping directions held for this step
         ref = unit.copy()
@@ -242,10 +205,14 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             if found:
                 break
         if not found:
-            return StepResult(z, False, "line search failed: no decrease of the energy "
-                              "along the Newton or the gradient direction", it,
-                              residual / scale, tol, E, np.zeros(nz),
-                              np.zeros(nz, dtype=bool), stuck)
+            status = LINE_SEARCH_FAILED
+            break
         z, E = trial, E_trial
-    return StepResult(z, False, f"no convergence in {max_iter} iterations", max_iter,
-                      residual / scale, tol, E, np.zeros(nz), np.zeros(nz, dtype=bool), stuck)
+    # one exit: the wall multipliers and sets of the last iterate z
+    message = MESSAGES[status].format(max_iter=max_iter)
+    if inner_failures:
+        message += f" ({inner_failures} Newton systems solved inexactly)"
+    return StepResult(z=z, status=status, message=message, nit=it,
+                      residual=residual / scale, tolerance=tol, energy=E,
+                      inner_failures=inner_failures, multiplier=np.where(wall, -g, 0.0),
+                      on_wall=wall, stuck=at_zero)

@@ -92,7 +92,8 @@ def solve(scene, out):
     with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
                            file=sys.stderr) as bar:
         try:
-            solution = run_scheme(problem, progress=lambda n, N: bar.update(1))
+            solution = run_scheme(problem, progress=lambda n, N: bar.update(1),
+                                  raise_on_failure=True)
         except StepFailure as err:
             raise CliError(str(err), 1) from None
     try:

@@ -35,6 +35,8 @@ from scipy.optimize import minimize
 from scipy.sparse.linalg import spsolve
 
 from adhesive_contact import StepFailure, build_problem, parse_scene, solve
+from adhesive_contact.scheme import STEP_FAILED, STOPPED
+from adhesive_contact.step_solver import MAX_ITERATIONS
 
 E, NU, C = 1000.0, 0.3, 1.0e4
 SIZE, CELLS = (2.0, 0.5), (16, 4)
@@ -524,11 +526,36 @@ def test_step_failure_names_the_step():
     problem = build_problem(parse_scene(scene([TRESCA], ("150*x*t", "-80*t"), steps=2,
                                               solver="[solver]\nmax_iter = 1")))
     with pytest.raises(StepFailure) as info:
-        solve(problem)
+        solve(problem, raise_on_failure=True)
     err = info.value
     assert err.n == 1 and err.t == 0.5
     assert str(err).startswith("step 1 (t = 0.5) did not converge")
     assert "1 iterations" in str(err) and not err.result.success
+    assert err.result.status == MAX_ITERATIONS
+
+
+def test_failed_step_is_a_returned_status_with_the_history_before_it():
+    """Without raise_on_failure the same run returns: not successful, the
+    failure named, and the one level that converged (t = 0) kept."""
+    problem = build_problem(parse_scene(scene([TRESCA], ("150*x*t", "-80*t"), steps=2,
+                                              solver="[solver]\nmax_iter = 1")))
+    sol = solve(problem)
+    assert not sol.success and sol.status == STEP_FAILED
+    assert sol.failure.n == 1 and sol.message == str(sol.failure)
+    assert sol.t.tolist() == [0.0] and sol.u.shape[0] == sol.beta.shape[0] == 1
+    complete = solve(problem, raise_on_failure=False, progress=None)
+    np.testing.assert_array_equal(complete.u, sol.u)   # the problem was not changed
+
+
+def test_progress_callback_can_stop_a_run():
+    problem = build_problem(parse_scene(scene([TRESCA], ("150*x*t", "-80*t"), steps=4)))
+    seen = []
+    sol = solve(problem, progress=lambda n, N: seen.append(n) or n == 2)
+    assert seen == [0, 1, 2] and sol.status == STOPPED and not sol.success
+    assert sol.t.size == 3 and sol.message == "stopped after step 2 (t = 0.5)"
+    full = solve(problem)
+    assert full.success and full.t.size == 5
+    np.testing.assert_array_equal(full.u[:3], sol.u)
 
 
 def test_power_law_near_zero_slip_converges():

@@ -1,0 +1,16 @@
+"""The fully discrete scheme of Problem 4.1 as a layer.
+
+- :mod:`.operators`: what a run builds once per mesh and step size (the
+  frame rotation and the condensed step matrices, :mod:`.condensed`);
+- :mod:`.state`: the state of level n and the functions that advance it,
+  one per equation: the bonding step (4.2), the step load with the memory
+  history, the step solve (4.1);
+- :mod:`.recorder`: what is kept of each level;
+- :mod:`.loop`: the time loop, :func:`solve`;
+- :mod:`.solution`: what a run returns, :class:`Solution`.
+"""
+
+from .loop import solve
+from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
+
+__all__ = ["solve", "Solution", "StepFailure", "SUCCESS", "STEP_FAILED", "STOPPED"]

@@ -1,0 +1,191 @@
+"""The step matrix condensed onto the contact unknowns.
+
+The step problem of (4.1) has the quadratic part ½ uᵀ a_n u − bᵀ u on the
+free dofs. Splitting them into contact dofs C and the rest I,
+
+    S = A_CC − A_CI A_II⁻¹ A_IC,    c = b_C − A_CI A_II⁻¹ b_I,
+
+the minimisation over u becomes one over the contact unknowns z = u_C
+only, ½ zᵀ S z − cᵀ z + contact terms; then u_I = A_II⁻¹ (b_I − A_IC z).
+(The caller writes the system in the nodal frames of
+:mod:`adhesive_contact.contact_boundary`, so z are frame components.)
+
+A_II is factorised once per mesh and step size (a linear backend of
+:mod:`adhesive_contact.linear`), and S is read off a second factorisation
+with the contact unknowns ordered last (or, should SuperLU reorder them,
+formed by one solve per contact unknown); a step then costs two solves with
+the factors of A_II.
+
+S reaches the step solver as one of two operators with the same interface
+(``S @ z``, ``diagonal()``, ``newton_solve``): :class:`DenseSchur`, formed,
+or :class:`ImplicitSchur`, applied only.
+"""
+
+import time
+
+import numpy as np
+import scipy.linalg as la
+import scipy.sparse as sp
+from scipy.sparse.linalg import LinearOperator, cg, splu
+
+from ..linear import DirectSolver
+
+
+def dense_solver(H):
+    """A solver for the dense symmetric H: Cholesky, or, when H is not
+    positive definite (a nonconvex step energy), the modified factorisation
+    with |eigenvalues| floored at 1e-8 of the largest."""
+    try:
+        factor = la.cho_factor(H, check_finite=False)
+        return lambda rhs: la.cho_solve(factor, rhs, check_finite=False)
+    except la.LinAlgError:
+        vals, vecs = la.eigh(H)
+        vals = np.maximum(np.abs(vals), 1e-8 * max(np.abs(vals).max(), 1e-300))
+        return lambda rhs: vecs @ ((vecs.T @ rhs) / vals)
+
+
+class DenseSchur:
+    """S formed: a dense symmetric (nC, nC) matrix."""
+
+    def __init__(self, S):
+        self.matrix = S
+        self.shape = S.shape
+
+    def __matmul__(self, z):
+        return self.matrix @ z
+
+    def diagonal(self):
+        return np.diag(self.matrix)
+
+    def newton_solve(self, H_phi, rhs, free):
+        """Solve (S + H_φ)_FF d = rhs on the free coordinates F (a boolean
+        mask): ``(d, converged)``, by :func:`dense_solver`."""
+        H = self.matrix[np.ix_(free, free)] + H_phi[np.ix_(free, free)]
+        return dense_solver(H)(rhs), True
+
+
+class ImplicitSchur:
+    """S = A_CC − A_CI A_II⁻¹ A_IC applied to vectors, never formed, with a
+    dense ``approximation`` of it (a nearby Schur complement) that
+    preconditions its Newton systems.
+
+    For the t = 0 problem of a scene with memory (A instead of A + k R(0)),
+    used once: forming S would cost one solve per contact unknown, a product
+    costs one, and preconditioned by the Schur complement of A + k R(0) (a
+    relative perturbation of size k R(0)/A) CG needs a few.
+    """
+
+    def __init__(self, A_CC, A_CI, A_IC, solver, approximation, tol=1e-12, max_iter=100):
+        self.A_CC, self.A_CI, self.A_IC, self.solver = A_CC, A_CI, A_IC, solver
+        self.approximation = approximation
+        self.shape = approximation.shape
+        self.tol, self.max_iter = tol, max_iter
+
+    def __matmul__(self, z):
+        return self.A_CC @ z - self.A_CI @ self.solver.solve(self.A_IC @ z)
+
+    def diagonal(self):
+        return np.diag(self.approximation)
+
+    def newton_solve(self, H_phi, rhs, free):
+        """Solve (S + H_φ)_FF d = rhs by CG with S applied, preconditioned by
+        (approximation + H_φ)_FF: ``(d, converged)``."""
+        H_FF = H_phi[np.ix_(free, free)]
+        precondition = dense_solver(self.approximation[np.ix_(free, free)] + H_FF)
+        full = np.zeros(self.shape[0])
+
+        def apply(v):
+            full[free] = v
+            return (self @ full)[free] + H_FF @ v
+
+        m = rhs.size
+        d, info = cg(LinearOperator((m, m), matvec=apply, dtype=float), rhs,
+                     M=LinearOperator((m, m), matvec=precondition, dtype=float),
+                     rtol=self.tol, atol=0.0, maxiter=self.max_iter)
+        return d, info == 0
+
+
+class CondensedOperator:
+    """A step matrix on the free dofs, condensed onto the contact unknowns.
+
+    Parameters
+    ----------
+    A : sparse (nfree, nfree)
+        The step matrix restricted to the free dofs.
+    contact : (nC,) int
+        Positions, within the free dofs, of the contact unknowns.
+    chunk : int
+        Right-hand sides per block solve when forming S (SuperLU's block
+        solve is fastest per column for a few columns at a time).
+    approximation : dense (nC, nC), optional
+        A nearby Schur complement: then S is not formed but applied
+        (:class:`ImplicitSchur`), for an operator used for one step only.
+    """
+
+    def __init__(self, A, contact, chunk=16, approximation=None):
+        t0 = time.perf_counter()
+        n = A.shape[0]
+        self.contact = np.asarray(contact, dtype=np.int64)
+        mask = np.ones(n, dtype=bool)
+        mask[self.contact] = False
+        self.interior = np.flatnonzero(mask)
+        A = sp.csr_matrix(A)
+        A_II = A[self.interior][:, self.interior]
+        self.A_IC = A[self.interior][:, self.contact].tocsc()
+        self.A_CI = self.A_IC.T.tocsr()
+        self.solver = DirectSolver(A_II)   # the linear backend
+        self.factor_seconds = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        nC = self.contact.size
+        if approximation is not None:
+            # S is applied, not formed: one solve pair per product
+            self.S = ImplicitSchur(A[self.contact][:, self.contact].tocsr(), self.A_CI,
+                                   self.A_IC, self.solver, approximation)
+            self.schur_seconds = time.perf_counter() - t0
+            return
+        S = self._schur_by_factorisation(A) if nC else None
+        if S is None:   # one block solve per contact unknown
+            S = A[self.contact][:, self.contact].toarray()
+            for start in range(0, nC, chunk):
+                cols = slice(start, min(start + chunk, nC))
+                X = self.solver.solve(np.asfortranarray(self.A_IC[:, cols].toarray()))
+                S[:, cols] -= self.A_CI @ X
+        self.S = DenseSchur(0.5 * (S + S.T))
+        self.schur_seconds = time.perf_counter() - t0
+
+    def _schur_by_factorisation(self, A):
+        """S as the trailing block of an LU factorisation with C ordered last.
+
+        With the interior in the fill-reducing order SuperLU chose for A_II
+        and the contact unknowns after it, factorised without reordering
+        (symmetric mode: diagonal pivots), A = L U and S = L_CC U_CC. That
+        costs about one more factorisation instead of one solve per contact
+        unknown. None if SuperLU moved a row or column of the C block.
+        """
+        if self.solver.lu is None:
+            return None
+        order = np.concatenate([self.interior[np.argsort(self.solver.lu.perm_c)], self.contact])
+        n, nC = order.size, self.contact.size
+        lu = splu(sp.csc_matrix(A[order][:, order]), permc_spec="NATURAL",
+                  options={"SymmetricMode": True, "DiagPivotThresh": 1e-3})
+        tail = np.arange(n - nC, n)
+        if not (np.array_equal(lu.perm_c[-nC:], tail) and np.array_equal(lu.perm_r[-nC:], tail)):
+            return None
+        L = lu.L.tocsc()[n - nC:, n - nC:].toarray()
+        U = lu.U.tocsc()[n - nC:, n - nC:].toarray()
+        return L @ U
+
+    def reduce(self, b):
+        """c = b_C − A_CI A_II⁻¹ b_I for a load b on the free dofs."""
+        if self.contact.size == 0:
+            return np.zeros(0)
+        y = self.solver.solve(b[self.interior])
+        return b[self.contact] - self.A_CI @ y
+
+    def expand(self, z, b):
+        """The free-dof solution u with u_C = z and u_I = A_II⁻¹(b_I − A_IC z)."""
+        u = np.empty(b.size)
+        u[self.contact] = z
+        u[self.interior] = self.solver.solve(b[self.interior] - self.A_IC @ z)
+        return u

@@ -1,0 +1,69 @@
+"""The time loop of the fully discrete scheme (Problem 4.1).
+
+u_0 solves the problem at t = 0 with the elastic stiffness alone (no memory
+yet). For n = 1..N, with k = T/N and t_n = n k: the explicit Euler step
+(4.2) gives β_n from level n − 1; u_n minimises the step energy with the
+step matrix A + k R(0), the load f(t_n) minus the memory history (right
+rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
+"""
+
+import time
+
+from .operators import StepOperators
+from .recorder import HistoryRecorder
+from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
+from .state import ContactStep, State, bonding_step, initial_state, step_load, step_solve
+
+
+def solve(problem, progress=None, raise_on_failure=False, recorder=None):
+    """Run the scheme on a :class:`~adhesive_contact.problem.Problem`.
+
+    Parameters
+    ----------
+    problem : Problem (never changed by the run)
+    progress : callable ``progress(n, N)``, called after each level; a
+        return value of True stops the run (status STOPPED)
+    raise_on_failure : raise :class:`StepFailure` when a step does not
+        converge, instead of returning the history up to it
+    recorder : what to keep per level (default :class:`HistoryRecorder`)
+
+    Returns
+    -------
+    Solution : ``success``, ``status``, ``message`` say how the run ended.
+    """
+    t0 = time.perf_counter()
+    memory = problem.start_memory()
+    operators = StepOperators.build(problem, memory)
+    contact = ContactStep(problem) if problem.boundary is not None else None
+    recorder = recorder or HistoryRecorder(problem)
+    state = initial_state(problem, memory)
+    status, failure = SUCCESS, None
+    t_loop = time.perf_counter()
+    for n, t in enumerate(problem.times):
+        beta = bonding_step(problem, state)                                  # (4.2)
+        b, history = step_load(problem, operators, state, n, t)
+        level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
+                                                  beta, history, state.z)   # (4.1)
+        if level is None:
+            status, failure = STEP_FAILED, StepFailure(n, t, result)
+            break
+        recorder.record(level)
+        if n >= 1:
+            memory.advance(n, u)
+        state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=memory)
+        if progress is not None and progress(n, problem.scene.steps) is True:
+            status = STOPPED if n < problem.scene.steps else SUCCESS
+            break
+    if failure is not None and raise_on_failure:
+        raise failure
+    t_end = time.perf_counter()
+    timings = {"assembly": problem.assembly_seconds,
+               "factorisation": operators.factor_seconds,
+               "schur": operators.schur_seconds,
+               "stepping": t_end - t_loop,
+               "total": problem.assembly_seconds + (t_end - t0)}
+    message = {SUCCESS: "all steps converged", STEP_FAILED: str(failure),
+               STOPPED: f"stopped after step {state.n} (t = {state.t:g})"}[status]
+    return Solution(problem=problem, status=status, message=message, failure=failure,
+                    t=problem.times[:recorder.count].copy(), timings=timings,
+                    **recorder.history())

@@ -1,0 +1,77 @@
+"""What a run builds once per mesh and step size.
+
+The system is written in the nodal frames of Γ_C, ũ = Rᵀ u
+(:meth:`~adhesive_contact.contact_boundary.ContactBoundary.rotation`), and
+restricted to the free dofs. Two step matrices serve the whole run
+(:mod:`adhesive_contact.scheme.condensed`):
+
+- a_n = A + k R(0) for n ≥ 1 (the j = n term of the right rectangle rule
+  joins the stiffness), formed Schur complement;
+- A alone at t = 0 (no memory yet). With memory it serves one step, so its
+  Schur complement is applied, not formed, preconditioned by the first.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .condensed import CondensedOperator
+
+
+@dataclass
+class StepOperators:
+    """The condensed step matrices and the frame rotation of a run."""
+
+    rotation: object             # sparse R (ndofs, ndofs), or None without Γ_C
+    free: np.ndarray             # the free dofs
+    initial: CondensedOperator   # A, for t = 0
+    step: CondensedOperator      # A + k R(0), for n ≥ 1
+    tensors: tuple               # (λ, μ) of A and of A + k R(0)
+    factor_seconds: float
+    schur_seconds: float
+
+    @classmethod
+    def build(cls, problem, memory):
+        """Factorise and condense the step matrices of ``problem`` with the
+        instantaneous tensor k R(0) of ``memory``."""
+        t0 = time.perf_counter()
+        assembly, free = problem.assembly, problem.free
+        R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
+
+        def condensed(lam, mu, approximation=None):
+            A = assembly.stiffness(lam, mu)
+            if R is not None:
+                A = (R.T @ A @ R).tocsr()
+            return CondensedOperator(A[free][:, free], problem.contact_positions,
+                                     approximation=approximation)
+
+        material = problem.scene.material
+        elastic = (material.lam, material.mu)
+        dlam, dmu = memory.instantaneous(problem.scene.k)
+        stepped = (material.lam + dlam, material.mu + dmu)
+        step = condensed(*stepped)
+        initial = step if (dlam, dmu) == (0.0, 0.0) else condensed(
+            *elastic, approximation=step.S.matrix)
+        schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
+        return cls(rotation=R, free=free, initial=initial, step=step,
+                   tensors=(elastic, stepped),
+                   factor_seconds=time.perf_counter() - t0, schur_seconds=schur)
+
+    def at(self, n):
+        """The condensed step matrix of level n."""
+        return self.initial if n == 0 else self.step
+
+    def tensor(self, n):
+        """(λ, μ) of the step matrix of level n."""
+        return self.tensors[0] if n == 0 else self.tensors[1]
+
+    def to_frames(self, f):
+        """A load vector (ndofs,) in nodal frames, restricted to the free dofs."""
+        if self.rotation is not None:
+            f = self.rotation.T @ f
+        return f[self.free]
+
+    def from_frames(self, u_frame):
+        """Cartesian components u = R ũ of a nodal-frame vector (ndofs,)."""
+        return self.rotation @ u_frame if self.rotation is not None else u_frame

@@ -1,0 +1,94 @@
+"""What a run returns: the history it kept and how it ended."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Solution.status
+SUCCESS, STEP_FAILED, STOPPED = 0, 1, 2
+
+
+class StepFailure(RuntimeError):
+    """A step solve that did not converge; carries the step and its result."""
+
+    def __init__(self, n, t, result):
+        self.n, self.t, self.result = n, t, result
+        super().__init__(
+            f"step {n} (t = {t:g}) did not converge: {result.message}; projected "
+            f"residual reached {result.residual:.2e} (tolerance {result.tolerance:.1e}) "
+            f"after {result.nit} iterations. Try more time steps (smaller k), a larger "
+            f"solver.max_iter, or check the smallness condition of the contact laws")
+
+    def __reduce__(self):   # survive pickling back from a worker process
+        return (type(self), (self.n, self.t, self.result))
+
+
+@dataclass
+class Solution:
+    """The discrete history, and how the run ended (cf. scipy's OptimizeResult).
+
+    Arrays are indexed by the time level n = 0..M, M = N for a run that
+    succeeded; a run that stopped early (a step that did not converge, or
+    a progress callback that asked to stop) holds the levels that converged
+    before it, and says so in ``success``, ``status``, ``message``."""
+
+    problem: object
+    status: int                   # SUCCESS, STEP_FAILED or STOPPED
+    message: str
+    failure: object               # the StepFailure of a failed step, else None
+    t: np.ndarray                 # (M+1,)
+    u: np.ndarray                 # (M+1, npoints, d)
+    beta: np.ndarray              # (M+1, nf) β per contact facet
+    stress: np.ndarray            # (M+1, ncells, d, d) σ_n per cell
+    stress_zz: np.ndarray         # (M+1, ncells) plane strain σ_zz (2D), or None
+    contact_force: np.ndarray     # (M+1, nc, d) force of Γ_C on the body, nodal frames
+    frame_displacement: np.ndarray  # (M+1, nc, d) [u_ν, u_τ] at the contact nodes
+    on_wall: np.ndarray           # (M+1, nc) bool
+    stuck: np.ndarray             # (M+1, nc) bool: held at ξ = 0 by a friction kink
+    probes: np.ndarray            # (M+1, nprobes, d)
+    iterations: np.ndarray        # (M+1,) Newton iterations per step
+    residual: np.ndarray          # (M+1,) final relative projected residual
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def success(self):
+        """True when every level n = 0..N converged."""
+        return self.status == SUCCESS
+
+    @property
+    def steps(self):
+        """The number of steps computed, M (levels 1..M)."""
+        return self.t.size - 1
+
+    @property
+    def normal_displacement(self):
+        """u_ν at the contact nodes (M+1, nc)."""
+        return self.frame_displacement[:, :, 0]
+
+    def contact_states(self):
+        """Counts per level of contact nodes that are separated (u_ν < 0),
+        on the wall, stuck (ξ = 0 held by friction) and slipping (the rest
+        in contact with friction): a dict of (M+1,) int arrays."""
+        separated = self.normal_displacement < 0
+        touching = ~separated
+        out = {"separated": separated.sum(axis=1), "on_wall": self.on_wall.sum(axis=1)}
+        if self.problem.friction is not None:
+            moving = np.linalg.norm(self.frame_displacement[:, :, 1:], axis=2) > 0
+            out["stick"] = (touching & self.stuck).sum(axis=1)
+            out["slip"] = (touching & ~self.stuck & moving).sum(axis=1)
+        return out
+
+    def total_normal_force(self):
+        """Σ_a of the normal force Γ_C exerts, positive in compression (M+1,)."""
+        return -self.contact_force[:, :, 0].sum(axis=1)
+
+    def total_tangential_force(self):
+        """Σ_a of the tangential forces in the nodal tangent frames (M+1, d−1)."""
+        return self.contact_force[:, :, 1:].sum(axis=1)
+
+    def gap_violation(self):
+        """max_a (u_ν − g) per level (−inf without a wall or contact nodes)."""
+        gap = self.problem.gap
+        if gap is None or gap.shape[1] == 0:
+            return np.full(self.t.size, -np.inf)
+        return (self.normal_displacement - gap[:self.t.size]).max(axis=1)

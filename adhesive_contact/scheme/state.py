@@ -1,0 +1,159 @@
+"""The state of the scheme and the functions that advance it, one per
+equation of the fully discrete Problem 4.1.
+
+A :class:`State` is what level n leaves for level n + 1: β_n, u_n, the
+contact unknowns (the next Newton start) and the memory history. It
+belongs to one run: the built-once :class:`~adhesive_contact.problem.Problem`
+is never changed by a run.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact_energy import ContactEnergy
+from ..expressions import coordinates
+from ..step_solver import Kink, minimise_step
+from .threads import one_blas_thread
+
+
+@dataclass
+class State:
+    """Level n of a run."""
+
+    n: int
+    t: float
+    beta: np.ndarray     # (nf,) β_n per contact facet
+    z: np.ndarray        # the step's contact unknowns (nodal frames)
+    u: np.ndarray        # (ndofs,) u_n, Cartesian
+    frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes
+    memory: object       # the run's memory history (adhesive_contact.memory)
+
+
+@dataclass
+class Level:
+    """What level n computed: the fields a recorder may keep."""
+
+    n: int
+    t: float
+    u: np.ndarray                 # (npoints, d)
+    beta: np.ndarray              # (nf,)
+    stress: np.ndarray            # (ncells, d, d)
+    stress_zz: np.ndarray         # (ncells,) plane strain σ_zz, or None in 3D
+    contact_force: np.ndarray     # (nc, d) force of Γ_C on the body, nodal frames
+    frame_displacement: np.ndarray  # (nc, d)
+    on_wall: np.ndarray           # (nc,) bool
+    stuck: np.ndarray             # (nc,) bool
+    probes: np.ndarray            # (nprobes, d)
+    iterations: int
+    residual: float
+
+
+class ContactStep:
+    """The contact terms Φ of a run's steps and the kinks of its friction
+    (:mod:`adhesive_contact.contact_energy`, :mod:`adhesive_contact.step_solver`)."""
+
+    def __init__(self, problem):
+        boundary, nc, d = problem.boundary, problem.boundary.nodes.size, problem.dim
+        self.problem = problem
+        self.energy = ContactEnergy(boundary, problem.columns, problem.normal_law,
+                                    problem.friction, problem.beta0)
+        self.kink = None
+        if problem.friction is not None:
+            # every friction law gets its slip directions held (κ_a = 0 without a
+            # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ
+            tangential = np.arange(problem.columns.size).reshape(nc, d)[:, 1:]
+            self.kink = Kink(tangential, np.zeros(nc))
+
+    def minimise(self, S, c, beta, n, z0):
+        """The step solve of (4.1) on the contact unknowns with β_n."""
+        problem = self.problem
+        self.energy.set_bonding(beta)
+        if self.kink is not None:
+            self.kink.radius = self.energy.node_kink(problem.boundary.point_node,
+                                                     problem.boundary.nodes.size)
+        solver = problem.scene.solver
+        with one_blas_thread():
+            return minimise_step(S, c, self.energy, problem.upper_bound(n), z0,
+                                 solver.tol, solver.max_iter, self.kink)
+
+
+def initial_state(problem, memory):
+    """Level "−1": β_0^h = P_B β_0, zero displacement, an empty history."""
+    nc = 0 if problem.boundary is None else problem.boundary.nodes.size
+    memory.begin(problem.scene.k, problem.ndofs)
+    return State(n=-1, t=-problem.scene.k, beta=problem.beta0.copy(),
+                 z=np.zeros(problem.columns.size), u=np.zeros(problem.ndofs),
+                 frame_u=np.zeros(nc * problem.dim), memory=memory)
+
+
+def bonding_step(problem, state):
+    """(4.2): β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
+    without a bonding law, and at n = 0)."""
+    if problem.bonding is None or state.n < 0:
+        return state.beta
+    boundary = problem.boundary
+    r = boundary.normal_trace @ state.frame_u
+    xi = (np.stack([t @ state.frame_u for t in boundary.tangential_trace], axis=-1)
+          if boundary.tangential_trace else None)
+    rate = problem.bonding.rate(r, xi, boundary.at_points(state.beta))
+    if problem.beta_source is not None:   # manufactured solutions only
+        rate = rate + problem.beta_source(*coordinates(boundary.points), t=state.t)
+    return state.beta + problem.scene.k * boundary.facet_mean(rate)
+
+
+def step_load(problem, operators, state, n, t):
+    """The load of level n on the free dofs in nodal frames: f(t_n) minus
+    the force of the memory history k Σ_{j<n} R(t_n − t_j) ε(u_j); and the
+    history's (a_λ, a_μ) fields (None at n = 0 and while the history is zero)."""
+    f = problem.loads(t)
+    history = state.memory.history(n) if n >= 1 else None
+    if history is not None:
+        f -= problem.assembly.force(*history)
+    return operators.to_frames(f), history
+
+
+def step_solve(problem, operators, contact, n, t, b, beta, history, z0):
+    """(4.1) at level n: the nonsmooth problem on the contact unknowns, then
+    the interior by back substitution, the stress
+    σ_n = C ε(u_n) + k R(0) ε(u_n) + history and the contact reactions.
+
+    Returns ``(level, u, frame_u, z, result)``; ``result`` is the
+    :class:`~adhesive_contact.step_solver.StepResult` (None without Γ_C)."""
+    step = operators.at(n)
+    c = step.reduce(b)
+    d = problem.dim
+    nc = 0 if problem.boundary is None else problem.boundary.nodes.size
+    force = np.zeros((nc, d))
+    on_wall = np.zeros(nc, dtype=bool)
+    stuck = np.zeros(nc, dtype=bool)
+    result, z = None, z0
+    if contact is not None:
+        result = contact.minimise(step.S, c, beta, n, z0)
+        if not result.success:
+            return None, None, None, z0, result
+        z = result.z
+        # the force of Γ_C on the body: its reaction in the frame equations
+        force.reshape(-1)[problem.columns] = step.S @ z - c
+        on_wall = result.on_wall[problem.normal_columns]
+        if contact.kink is not None and problem.friction.has_kink:
+            stuck = result.stuck
+    u_frame = np.zeros(problem.ndofs)
+    u_frame[operators.free] = step.expand(z, b)
+    frame_u = u_frame[problem.boundary.dofs.ravel()] if nc else np.zeros(0)
+    u = operators.from_frames(u_frame)
+
+    lam, mu = operators.tensor(n)
+    a_lam, a_mu = lam * u, mu * u
+    if history is not None:
+        a_lam, a_mu = a_lam + history[0], a_mu + history[1]
+    stress, zz = problem.assembly.cell_stress(a_lam, a_mu)
+    points = u.reshape(-1, d)
+    level = Level(
+        n=n, t=t, u=points, beta=beta, stress=stress, stress_zz=zz if d == 2 else None,
+        contact_force=force, frame_displacement=frame_u.reshape(nc, d), on_wall=on_wall,
+        stuck=stuck, probes=(problem.probe_map @ points if problem.probe_map is not None
+                             else np.zeros((0, d))),
+        iterations=0 if result is None else result.nit,
+        residual=0.0 if result is None else result.residual)
+    return level, u, frame_u, z, result
