@@ -21,6 +21,7 @@ callables f(x, y, z, t) (z None in 2D).
 """
 
 import ast
+from functools import partial
 
 import numpy as np
 
@@ -97,10 +98,17 @@ class ManufacturedSolution:
     ----------
     scene : Scene with ``exact`` set
     normal_law, friction, bonding : the scene's law objects
-    memory : list of (kernel(lag) callable, λ, μ) terms of R, or []
+    kernel_terms : list of (kernel(lag) callable, λ, μ) terms of R, or []
+        (default: :func:`memory_terms` of the scene)
+
+    Pickles by its arguments: the numpy functions are derived again on
+    unpickling (sympy's lambdified functions do not pickle).
     """
 
-    def __init__(self, scene, normal_law, friction, bonding, memory_terms):
+    def __init__(self, scene, normal_law, friction, bonding, kernel_terms=None):
+        self._arguments = (scene, normal_law, friction, bonding)
+        if kernel_terms is None:
+            kernel_terms = memory_terms(scene)
         sp = _sympy()
         d = scene.dim
         self.dim = d
@@ -124,7 +132,7 @@ class ManufacturedSolution:
         self._grad_div = [L(c) for c in grad_div]
         self._div_mu = [L(c) for c in div_mu]
         self.lam, self.mu = lam, mu
-        self.memory = memory_terms
+        self.memory = kernel_terms
         self.normal_law, self.friction, self.bonding = normal_law, friction, bonding
         beta = to_sympy(scene.exact.beta, env) if scene.exact.beta is not None else sp.Integer(1)
         self._beta = L(beta)
@@ -134,6 +142,9 @@ class ManufacturedSolution:
         self.gap = scene.contact.gap
         xg, wg = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
         self._gauss = (0.5 * (xg + 1.0), 0.5 * wg)   # on [0, 1]
+
+    def __reduce__(self):
+        return (type(self), self._arguments)
 
     # -- fields ---------------------------------------------------------
 
@@ -190,11 +201,13 @@ class ManufacturedSolution:
         return f if hist is None else f - hist
 
     def traction(self, normal):
-        """f_N = σ* n on a side with outward normals n (d, …)."""
-        def f(x, y=None, z=None, t=0.0):
-            sig = self.stress(x, y, z, t)
-            return np.einsum("ij...,j...->i...", sig, np.broadcast_to(normal, sig.shape[1:]))
-        return f
+        """f_N = σ* n on a side with outward normals n (d, …): a function
+        f(x, y, z, t)."""
+        return partial(self._traction, normal)
+
+    def _traction(self, normal, x, y=None, z=None, t=0.0):
+        sig = self.stress(x, y, z, t)
+        return np.einsum("ij...,j...->i...", sig, np.broadcast_to(normal, sig.shape[1:]))
 
     def _frame(self, x, y, z, t, normal, tangents):
         """u*, u*_ν, u*_τ (…, m) and β* at points with normals (d, …) and
@@ -205,33 +218,37 @@ class ManufacturedSolution:
         return u, r, xi, self.beta(x, y, z, t)
 
     def contact_load(self, normal, tangents):
-        """f_C on Γ_C with outward normals ν (d, …) and tangents τ (m, d, …)."""
-        def f(x, y=None, z=None, t=0.0):
-            u, r, xi, beta = self._frame(x, y, z, t, normal, tangents)
-            sig_n = np.einsum("ij...,j...->i...", self.stress(x, y, z, t),
-                              np.broadcast_to(normal, u.shape))
-            push = self.normal_law.value(beta, r)
-            if self.gap is not None and self._multiplier is not None:
-                g = self.gap(x, y, z, t=t)
-                on_wall = np.abs(r - g) <= 1e-12 * (1.0 + np.abs(g))
-                push = push + np.where(on_wall, self._multiplier(x, y, z, t), 0.0)
-            load = sig_n + push * normal
-            if self.friction is not None:
-                force = self.friction.gradient(beta, xi)    # 0 where ξ = 0
-                for k, tt in enumerate(tangents):
-                    load = load + force[..., k] * tt
-            return load
-        return f
+        """f_C on Γ_C with outward normals ν (d, …) and tangents τ (m, d, …):
+        a function f(x, y, z, t)."""
+        return partial(self._contact_load, normal, tangents)
+
+    def _contact_load(self, normal, tangents, x, y=None, z=None, t=0.0):
+        u, r, xi, beta = self._frame(x, y, z, t, normal, tangents)
+        sig_n = np.einsum("ij...,j...->i...", self.stress(x, y, z, t),
+                          np.broadcast_to(normal, u.shape))
+        push = self.normal_law.value(beta, r)
+        if self.gap is not None and self._multiplier is not None:
+            g = self.gap(x, y, z, t=t)
+            on_wall = np.abs(r - g) <= 1e-12 * (1.0 + np.abs(g))
+            push = push + np.where(on_wall, self._multiplier(x, y, z, t), 0.0)
+        load = sig_n + push * normal
+        if self.friction is not None:
+            force = self.friction.gradient(beta, xi)    # 0 where ξ = 0
+            for k, tt in enumerate(tangents):
+                load = load + force[..., k] * tt
+        return load
 
     def beta_source(self, normal, tangents):
-        """s_β = ∂_t β* − F(u*_ν, u*_τ, β*) at points of Γ_C."""
-        def f(x, y=None, z=None, t=0.0):
-            out = np.asarray(self._beta_t(x, y, z, t), dtype=float)
-            if self.bonding is None:
-                return out
-            u, r, xi, beta = self._frame(x, y, z, t, normal, tangents)
-            return out - self.bonding.rate(r, xi, beta)
-        return f
+        """s_β = ∂_t β* − F(u*_ν, u*_τ, β*) at points of Γ_C: a function
+        f(x, y, z, t)."""
+        return partial(self._beta_source, normal, tangents)
+
+    def _beta_source(self, normal, tangents, x, y=None, z=None, t=0.0):
+        out = np.asarray(self._beta_t(x, y, z, t), dtype=float)
+        if self.bonding is None:
+            return out
+        u, r, xi, beta = self._frame(x, y, z, t, normal, tangents)
+        return out - self.bonding.rate(r, xi, beta)
 
 
 def memory_terms(scene):

@@ -24,7 +24,7 @@ from .contact_boundary import (
 )
 from .expressions import coordinates
 from .laws import make_bonding, make_friction, make_normal_law
-from .manufactured import ManufacturedSolution, memory_terms
+from .manufactured import ManufacturedSolution
 from .memory import make_memory
 from .mesh import build_mesh
 from .scene import SIDES, SceneError
@@ -187,7 +187,7 @@ def build_problem(scene):
         surface = [(mesh.boundaries[side], vector_of(exprs))
                    for side, exprs in scene.traction.items()]
     else:
-        exact = ManufacturedSolution(scene, normal_law, friction, bonding, memory_terms(scene))
+        exact = ManufacturedSolution(scene, normal_law, friction, bonding)
         body = exact.body_force
         neumann = [s for s in SIDES[d] if s not in scene.dirichlet + scene.contact_sides]
         surface = [(mesh.boundaries[side], exact.traction(_side_normal(side, d)[:, None]))

@@ -18,7 +18,7 @@ from pathlib import Path
 import click
 
 from adhesive_contact import StepFailure
-from adhesive_contact import solve as run_scheme
+from adhesive_contact import solve
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .converge import converge
@@ -71,13 +71,13 @@ def main():
     """Quasistatic adhesive contact of a viscoelastic body with long memory."""
 
 
-@main.command()
+@main.command("solve")
 @click.argument("scene", required=False,
                 type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder; in an existing one only the run's own files are replaced. "
                    "Default: ./<scene file stem>, ./default for the built-in scene.")
-def solve(scene, out):
+def solve_command(scene, out):
     """Run SCENE (a TOML file; the built-in default scene if omitted).
 
     Writes summary.json, solution.npz, solution.xdmf/.h5 (ParaView) and PNG
@@ -92,8 +92,8 @@ def solve(scene, out):
     with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
                            file=sys.stderr) as bar:
         try:
-            solution = run_scheme(problem, progress=lambda n, N: bar.update(1),
-                                  raise_on_failure=True)
+            solution = solve(problem, progress=lambda n, N: bar.update(1),
+                             raise_on_failure=True)
         except StepFailure as err:
             raise CliError(str(err), 1) from None
     try:
