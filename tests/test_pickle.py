@@ -14,7 +14,7 @@ from adhesive_contact.convergence import with_discretisation
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = {
     # memory, adhesive compliance, slip weakening, Frémond bonding
-    "debonding": (ROOT / "studies/scenes/debonding.toml", 0, 6),
+    "debonding": (ROOT / "studies/scenes/debonding.toml", 0, 50),
     # a manufactured solution: sympy-derived loads and the bonding source
     "manufactured": (ROOT / "studies/convergence/d_uneven_debonding.toml", 0, 4),
 }

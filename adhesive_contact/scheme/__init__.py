@@ -7,10 +7,12 @@
   history, the step solve (4.1);
 - :mod:`.recorder`: what is kept of each level;
 - :mod:`.loop`: the time loop, :func:`solve`;
+- :mod:`.checks`: what every level must satisfy (no quiet wrong answers);
 - :mod:`.solution`: what a run returns, :class:`Solution`.
 """
 
+from .checks import InvalidState
 from .loop import solve
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
 
-__all__ = ["solve", "Solution", "StepFailure", "SUCCESS", "STEP_FAILED", "STOPPED"]
+__all__ = ["solve", "Solution", "StepFailure", "InvalidState", "SUCCESS", "STEP_FAILED", "STOPPED"]

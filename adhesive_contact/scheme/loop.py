@@ -9,6 +9,7 @@ rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
 
 import time
 
+from .checks import check_level
 from .operators import StepOperators
 from .recorder import HistoryRecorder
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
@@ -24,7 +25,8 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     progress : callable ``progress(n, N)``, called after each level; a
         return value of True stops the run (status STOPPED)
     raise_on_failure : raise :class:`StepFailure` when a step does not
-        converge, instead of returning the history up to it
+        converge or gives an invalid state (:mod:`.checks`), instead of
+        returning the history up to it
     recorder : what to keep per level (default :class:`HistoryRecorder`)
 
     Returns
@@ -44,8 +46,9 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
         b, history = step_load(problem, operators, state, n, t)
         level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
                                                   beta, history, state.z)   # (4.1)
-        if level is None:
-            status, failure = STEP_FAILED, StepFailure(n, t, result)
+        failure = StepFailure(n, t, result) if level is None else check_level(problem, level)
+        if failure is not None:
+            status = STEP_FAILED
             break
         recorder.record(level)
         if n >= 1:

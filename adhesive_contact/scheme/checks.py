@@ -1,0 +1,75 @@
+"""No quiet wrong answers: what every converged level must satisfy.
+
+After each level the loop checks that
+
+- u_n, σ_n and β_n are finite;
+- 0 ≤ β_n ≤ 1 up to round-off (``BETA_SLACK``): the exact β stays in
+  [0, 1], but explicit Euler (4.2) leaves it once k (γ_ν + γ_τ) L² > 1,
+  and β² then revives the glue. Not for a manufactured solution: its
+  source s_β breaks the invariance of [0, 1] (F ≥ 0 for β ≤ 0, F ≤ 0 for
+  β ≥ 1), so a coarse k may leave it by the discretisation error alone;
+- u_ν ≤ g at the contact nodes up to round-off (``WALL_SLACK`` relative to
+  the size of g and u_ν): the step solve projects onto the wall exactly.
+
+A violation stops the run with :class:`InvalidState`, one paragraph that
+says what failed, where, the figures and what to try.
+"""
+
+import numpy as np
+
+from .solution import StepFailure
+
+BETA_SLACK = 1e-12
+WALL_SLACK = 1e-10
+
+
+class InvalidState(StepFailure):
+    """A level that converged to values the model does not allow."""
+
+    def __init__(self, n, t, reason):
+        self.n, self.t, self.result, self.reason = n, t, None, reason
+        RuntimeError.__init__(self, f"step {n} (t = {t:g}) gave an invalid state: {reason}")
+
+    def __reduce__(self):
+        return (type(self), (self.n, self.t, self.reason))
+
+
+def _where(problem, facet):
+    x = problem.mesh.p[:, problem.boundary.facet_nodes[:, facet]].mean(axis=1)
+    return "(" + ", ".join(f"{c:.4g}" for c in x) + ")"
+
+
+def check_level(problem, level):
+    """None if level n is admissible, else the :class:`InvalidState`."""
+    n, t = level.n, level.t
+    for name in ("u", "beta", "stress"):
+        if not np.all(np.isfinite(getattr(level, name))):
+            return InvalidState(n, t, f"{name} is not finite (NaN or infinity). Check the "
+                                "loads, the gap and the laws for values that overflow")
+    beta = level.beta
+    if beta.size and problem.beta_source is None and (beta.min() < -BETA_SLACK or beta.max() > 1 + BETA_SLACK):
+        facet = int(np.argmin(beta) if beta.min() < -BETA_SLACK else np.argmax(beta))
+        reason = (f"beta = {beta[facet]:.4g} leaves [0, 1] on the contact facet at "
+                  f"{_where(problem, facet)}")
+        bonding = problem.bonding
+        if bonding is not None:
+            k, bound = problem.scene.k, bonding.stable_step()
+            reason += (f". The explicit Euler step of the bonding law keeps beta in [0, 1] "
+                       f"only for k (gamma_nu + gamma_tau) L^2 <= 1, i.e. k <= {bound:.4g}; "
+                       f"this run has k = {k:.4g}")
+            if k > bound:
+                need = int(np.ceil(problem.scene.T / bound))
+                reason += f". Use at least time.steps = {need}"
+        return InvalidState(n, t, reason)
+    gap = problem.gap
+    if gap is not None and level.frame_displacement.shape[0]:
+        u_nu = level.frame_displacement[:, 0]
+        excess = u_nu - gap[n]
+        worst = int(np.argmax(excess))
+        scale = 1.0 + max(np.abs(gap[n]).max(), np.abs(u_nu).max())
+        if excess[worst] > WALL_SLACK * scale:
+            x = problem.mesh.p[:, problem.boundary.nodes[worst]]
+            return InvalidState(n, t, (
+                f"u_nu - g = {excess[worst]:.3g} > 0 at the contact node "
+                f"({', '.join(f'{c:.4g}' for c in x)}): the rigid wall is crossed"))
+    return None

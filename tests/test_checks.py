@@ -1,0 +1,97 @@
+"""No quiet wrong answers: a level with non-finite values, β outside
+[0, 1] or u_ν beyond the wall stops the run with InvalidState, the history
+before it kept."""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from adhesive_contact import build_problem, parse_scene, solve
+from adhesive_contact.convergence import with_discretisation
+from adhesive_contact.scheme import STEP_FAILED, InvalidState
+from adhesive_contact.scheme.checks import check_level
+from adhesive_contact.scheme.operators import StepOperators
+from adhesive_contact.scheme.state import (
+    ContactStep,
+    bonding_step,
+    initial_state,
+    step_load,
+    step_solve,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def debonding(steps):
+    text = (ROOT / "studies/scenes/debonding.toml").read_text()
+    return build_problem(with_discretisation(parse_scene(text), steps=steps))
+
+
+def test_explicit_euler_beyond_its_bound_stops_with_the_figures():
+    # the bound k <= 1/((gamma_nu + gamma_tau) L^2) = 1/15 with T = 1: 6 steps break it
+    problem = debonding(6)
+    bound = problem.bonding.stable_step()
+    assert problem.scene.k > bound
+    sol = solve(problem)
+    assert sol.status == STEP_FAILED and isinstance(sol.failure, InvalidState)
+    n = sol.failure.n
+    assert sol.t.size == n                     # levels 0..n-1 kept
+    assert np.all((sol.beta >= 0) & (sol.beta <= 1))
+    text = str(sol.failure)
+    assert f"step {n} (t = " in text and "leaves [0, 1]" in text
+    assert f"k <= {bound:.4g}" in text and f"k = {problem.scene.k:.4g}" in text
+    assert f"time.steps = {int(np.ceil(1 / bound))}" in text
+    with pytest.raises(InvalidState):
+        solve(problem, raise_on_failure=True)
+
+
+def test_within_the_bound_the_same_scene_runs():
+    assert solve(debonding(50)).success
+
+
+def test_non_finite_load_stops_at_step_zero():
+    # no contact boundary: before, a load 0/0 gave exit 0 and an all-NaN u
+    text = """
+dim = 2
+[mesh]
+domain = "rectangle"
+size = [1.0, 1.0]
+cells = [4, 4]
+[boundary]
+dirichlet = ["left"]
+contact = []
+[material]
+E = 1.0
+nu = 0.3
+[loads]
+body = ["0/0", "0"]
+[time]
+T = 1.0
+steps = 2
+"""
+    sol = solve(build_problem(parse_scene(text)))
+    assert isinstance(sol.failure, InvalidState) and sol.failure.n == 0
+    assert "u is not finite" in str(sol.failure) and sol.t.size == 0
+
+
+def test_a_level_beyond_the_wall_is_named():
+    """The exact step solve projects onto the wall, so the check is fed a
+    converged level moved beyond it: the node and the excess are named."""
+    problem = build_problem(parse_scene((ROOT / "studies/scenes/wall.toml").read_text()))
+    memory = problem.start_memory()
+    operators = StepOperators.build(problem, memory)
+    state = initial_state(problem, memory)
+    b, history = step_load(problem, operators, state, 0, 0.0)
+    level, *_ = step_solve(problem, operators, ContactStep(problem), 0, 0.0, b,
+                           bonding_step(problem, state), history, state.z)
+    assert check_level(problem, level) is None
+    moved = level.frame_displacement.copy()
+    a = 3
+    moved[a, 0] = problem.gap[0, a] + 1e-3
+    failure = check_level(problem, dataclasses.replace(level, frame_displacement=moved))
+    x = problem.mesh.p[:, problem.boundary.nodes[a]]
+    assert isinstance(failure, InvalidState)
+    assert "u_nu - g = 0.001 > 0" in str(failure)
+    assert f"({x[0]:.4g}, {x[1]:.4g})" in str(failure)
