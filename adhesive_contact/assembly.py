@@ -27,6 +27,7 @@ from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
 
 from .expressions import coordinates
+from .p1 import cell_load_map, stiffness_parts, strain_operator
 
 
 @BilinearForm
@@ -129,8 +130,7 @@ class LoadMap:
         elem = vector_element(d)
         self.parts = []
         if body is not None:
-            basis = Basis(mesh, elem, intorder=intorder)
-            self.parts.append((body, *quadrature_load_map(basis)))
+            self.parts.append((body, *cell_load_map(mesh, intorder)))
         for facets, field in surface:
             basis = FacetBasis(mesh, elem, facets=facets, intorder=intorder)
             self.parts.append((field, *quadrature_load_map(basis)))
@@ -146,19 +146,25 @@ class LoadMap:
 
 
 class Assembly:
-    """The per-mesh operators of the fully discrete scheme."""
+    """The per-mesh operators of the fully discrete scheme, from the
+    vectorised P1 kernels of :mod:`adhesive_contact.p1` (the forms above
+    give the same matrices; a test compares them)."""
 
     def __init__(self, mesh):
         self.mesh = mesh
         self.dim = mesh.dim()
-        self.basis = stiffness_basis(mesh)
-        self.K_lam = asm(divergence_product, self.basis).tocsr()
-        self.K_mu = asm(strain_product, self.basis).tocsr()
-        self.strain = strain_map(self.basis)
+        self.K_lam, self.K_mu = stiffness_parts(mesh)
+        self.strain = strain_operator(mesh)
 
     @property
     def ndofs(self):
-        return self.basis.N
+        return self.dim * self.mesh.p.shape[1]
+
+    @property
+    def nodal_dofs(self):
+        """(d, npoints): the dof of component c at node a, d·a + c (the
+        interleaved numbering of scikit-fem's vector elements)."""
+        return np.arange(self.ndofs).reshape(-1, self.dim).T
 
     def stiffness(self, lam, mu):
         """λ K_λ + μ K_μ, the stiffness of the isotropic tensor (λ, μ)."""

@@ -123,13 +123,13 @@ def build_problem(scene):
     t0 = time.perf_counter()
     mesh = build_mesh(scene.mesh)
     assembly = Assembly(mesh)
-    basis = assembly.basis
     d = mesh.dim()
 
     dirichlet_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
     clamped_nodes = np.unique(mesh.facets[:, dirichlet_facets])
-    free = np.setdiff1d(np.arange(basis.N), basis.nodal_dofs[:, clamped_nodes].ravel())
-    position = np.full(basis.N, -1)
+    free = np.setdiff1d(np.arange(assembly.ndofs),
+                        assembly.nodal_dofs[:, clamped_nodes].ravel())
+    position = np.full(assembly.ndofs, -1)
     position[free] = np.arange(free.size)
 
     times = scene.k * np.arange(scene.steps + 1)
@@ -140,7 +140,7 @@ def build_problem(scene):
         facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
         boundary = build_contact_boundary(mesh, facets, clamped_nodes,
                                           scene.contact.quadrature, scene.contact.order)
-        assert np.array_equal(basis.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
+        assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
         # without friction only u_ν enters the contact terms (the traces of
         # the tangential components vanish on flat facets): solve for it alone
         tangential = boundary.unknowns(np.arange(1, d))

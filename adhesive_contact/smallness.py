@@ -45,7 +45,7 @@ def trace_constant_squared(scene):
     asm_ = Assembly(mesh)
     d = mesh.dim()
     clamped_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
-    clamped = np.unique(asm_.basis.nodal_dofs[:, np.unique(mesh.facets[:, clamped_facets])])
+    clamped = np.unique(asm_.nodal_dofs[:, np.unique(mesh.facets[:, clamped_facets])])
     free = np.setdiff1d(np.arange(asm_.ndofs), clamped)
     facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
     fb = FacetBasis(mesh, vector_element(d), facets=facets, intorder=2)
