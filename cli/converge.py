@@ -21,15 +21,12 @@ Every file is written to a temporary file beside it and renamed into place,
 so a reader (or a rerun after a crash) never sees half a file.
 """
 
-import contextlib
 import csv
 import hashlib
 import json
 import math
 import multiprocessing
-import os
 import sys
-import tempfile
 import textwrap
 import zipfile
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -42,6 +39,7 @@ import numpy as np
 from matplotlib.ticker import NullFormatter  # noqa: E402
 
 from adhesive_contact import StepFailure, parse_scene
+from adhesive_contact.storage import plain, write_atomic, write_json
 from adhesive_contact.convergence import (
     PARAMS,
     Reference,
@@ -56,7 +54,6 @@ from adhesive_contact.convergence import (
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .plots import DPI
-from .postprocess import json_number
 
 STUDY = "study.json"
 REFERENCE = "reference.npz"
@@ -70,21 +67,6 @@ MEANINGFUL_LEVELS = 4   # MODEL.md §7: a rate is fitted over at least 4 levels
 
 
 # ---------------------------------------------------------------- the study
-
-
-def plain(value):
-    """``value`` with JSON types only: NaN and ±inf become None."""
-    if isinstance(value, dict):
-        return {str(k): plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [plain(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return json_number(value)
-    return value
 
 
 def study_document(scene, param, levels, reference, ref_h, ref_k):
@@ -130,32 +112,6 @@ def open_study(out, study):
         raise CliError(f"--out: {str(out)!r} is a non-empty folder that is not a "
                        f"convergence study (no {STUDY}); choose another folder", 2)
     return False
-
-
-# ---------------------------------------------------------------- atomic files
-
-
-def write_atomic(path, write, binary=False):
-    """Call ``write(file)`` on a temporary file beside ``path``, then rename it
-    to ``path`` (replacing it): readers see the old file or the whole new one."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.tmp-", dir=path.parent)
-    try:
-        with (os.fdopen(fd, "wb") if binary else
-              os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
-            write(f)
-        os.chmod(tmp, 0o644)   # mkstemp makes it private
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def write_json(path, document):
-    """Strict JSON (no NaN), atomically."""
-    text = json.dumps(plain(document), indent=1, allow_nan=False) + "\n"
-    write_atomic(path, lambda f: f.write(text))
 
 
 def level_path(out, level):
