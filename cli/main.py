@@ -19,11 +19,11 @@ import click
 
 from adhesive_contact import StepFailure
 from adhesive_contact import solve as run_scheme
+from adhesive_contact.postprocess import beta_mean
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .converge import converge
 from .output import write_outputs
-from .postprocess import beta_mean
 
 
 class OneLineGroup(click.Group):
