@@ -24,6 +24,7 @@ from adhesive_contact.postprocess import beta_mean
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .converge import converge
 from .output import write_outputs
+from .sweep import sweep
 
 
 class OneLineGroup(click.Group):
@@ -120,3 +121,4 @@ def solve(scene, out):
 
 
 main.add_command(converge)
+main.add_command(sweep)

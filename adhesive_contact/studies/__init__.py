@@ -4,7 +4,7 @@
 ``study.json``, one saved record per finished run, computing only what is
 missing); :mod:`.pool` runs the runs in this process, in local worker
 processes or on any executor; :mod:`.convergence` is the convergence study
-in h, k or both.
+in h, k or both, :mod:`.sweep` a parameter sweep.
 """
 
 from .convergence import ConvergenceResult, ConvergenceStudy
@@ -18,6 +18,8 @@ from .study import (
     StudyMismatch,
     study_document,
 )
+from .sweep import Sweep, SweepResult, parse_assignment
 
 __all__ = ["ConvergenceResult", "ConvergenceStudy", "execute", "RunFailed", "RunStore",
-           "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document"]
+           "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document",
+           "Sweep", "SweepResult", "parse_assignment"]
