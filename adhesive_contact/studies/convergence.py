@@ -26,7 +26,6 @@ From Python::
 
 import csv
 import math
-import tomllib
 import zipfile
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -49,7 +48,7 @@ from ..mesh import build_mesh
 from ..scene import scene_from_dict
 from ..storage import write_atomic, write_json
 from .pool import attempt
-from .study import RunFailed, Study, StudyError
+from .study import RunFailed, Study, StudyError, scene_source
 
 REFERENCE = "reference.npz"
 LEVELS = "levels"
@@ -62,22 +61,6 @@ MEANINGFUL_LEVELS = 4
 #: the largest run a study may ask for (dofs); beyond it the set-up alone
 #: (a Schur complement onto Γ_C) takes hours and tens of GB on a workstation
 MAX_DOFS = 2_000_000
-
-
-def scene_source(scene):
-    """The decoded TOML document of a scene given as TOML text (str), a path
-    of a TOML file (os.PathLike) or an already decoded dict.
-
-    Raises :class:`~adhesive_contact.SceneError` for text that is not TOML."""
-    from ..scene import SceneError
-
-    if isinstance(scene, dict):
-        return scene
-    text = Path(scene).read_text(encoding="utf-8") if not isinstance(scene, str) else scene
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError("", f"not valid TOML: {err}") from None
 
 
 # ---------------------------------------------------------------- the reference file

@@ -14,6 +14,7 @@ futures, with an ``as_completed(futures)`` yielding them as they finish
 """
 
 import multiprocessing
+import threading
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures import as_completed as futures_completed
 
@@ -23,6 +24,7 @@ from ..timestepping import StepFailure
 #: and token -> state built from it on first use
 _CONTEXTS = {}
 _STATES = {}
+_LOCK = threading.Lock()   # threaded workers build a state once too
 
 
 def _install(token, setup, args):
@@ -32,11 +34,12 @@ def _install(token, setup, args):
 
 def _state(token, context=None):
     """The process's state for ``token``, built once from its context."""
-    if token not in _STATES:
-        setup, args = context if context is not None else _CONTEXTS[token]
-        _STATES.clear()   # one study at a time per process
-        _STATES[token] = setup(*args)
-    return _STATES[token]
+    with _LOCK:
+        if token not in _STATES:
+            setup, args = context if context is not None else _CONTEXTS[token]
+            _STATES.clear()   # one study at a time per process
+            _STATES[token] = setup(*args)
+        return _STATES[token]
 
 
 def attempt(compute, state, key):

@@ -19,8 +19,10 @@ does the rest with :func:`~adhesive_contact.studies.pool.execute`.
 
 import hashlib
 import json
+import tomllib
 from pathlib import Path
 
+from ..scene import SceneError
 from ..storage import plain, read_json, write_json
 from .pool import execute
 
@@ -61,6 +63,20 @@ class RunFailed(RuntimeError):
     def __init__(self, label, message):
         self.label, self.message = label, message
         super().__init__(f"{label}: {message}")
+
+
+def scene_source(scene):
+    """The decoded TOML document of a scene given as TOML text (str), a path
+    of a TOML file (os.PathLike) or an already decoded dict.
+
+    Raises :class:`~adhesive_contact.SceneError` for text that is not TOML."""
+    if isinstance(scene, dict):
+        return scene
+    text = Path(scene).read_text(encoding="utf-8") if not isinstance(scene, str) else scene
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError("", f"not valid TOML: {err}") from None
 
 
 def study_document(identity):

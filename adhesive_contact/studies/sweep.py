@@ -39,8 +39,7 @@ from dataclasses import dataclass
 from .. import SceneError, StepFailure, build_problem, scene_from_dict, solve
 from ..postprocess import beta_mean, contact_states
 from ..storage import plain, write_atomic
-from .convergence import scene_source
-from .study import Study, StudyError
+from .study import Study, StudyError, scene_source
 
 MODES = ("grid", "zip")
 OUTCOMES = ("ok", "failed")
