@@ -2,7 +2,8 @@
 
 A thin layer over :mod:`adhesive_contact`: :mod:`.main` parses arguments,
 reads the scene, calls the library and reports errors in one line;
-:mod:`.postprocess` derives the reported quantities from a solution;
+:mod:`.postprocess` formats the records of ``summary.json`` (the quantities
+come from :mod:`adhesive_contact.postprocess`);
 :mod:`.output` writes the output folder (JSON, NPZ, XDMF) atomically and
 :mod:`.plots` draws its PNG figures.
 """

@@ -19,11 +19,12 @@ import click
 
 from adhesive_contact import StepFailure
 from adhesive_contact import solve
+from adhesive_contact.postprocess import beta_mean
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .converge import converge
 from .output import write_outputs
-from .postprocess import beta_mean
+from .sweep import sweep
 
 
 class OneLineGroup(click.Group):
@@ -121,3 +122,4 @@ def solve_command(scene, out):
 
 
 main.add_command(converge)
+main.add_command(sweep)

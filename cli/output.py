@@ -18,7 +18,6 @@ half-written ``DIR`` and a user's own files in ``DIR`` are never touched:
 - PNG plots (:mod:`.plots`).
 """
 
-import json
 import os
 import shutil
 import tempfile
@@ -27,15 +26,11 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+from adhesive_contact.postprocess import stress_3x3, von_mises
+from adhesive_contact.storage import json_number, write_json
+
 from . import plots
-from .postprocess import (
-    json_number,
-    pad_vectors,
-    smallness_record,
-    step_records,
-    stress_3x3,
-    von_mises,
-)
+from .postprocess import smallness_record, step_records
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 FACET_TYPES = {2: "line", 3: "triangle"}
@@ -56,6 +51,13 @@ class _XdmfSeriesWriter(meshio.xdmf.TimeSeriesWriter):
         self.h5_filename = str(self.filename.with_suffix(".h5"))
         self.h5_file = h5py.File(self.h5_filename, "w")
         return self
+
+
+def pad_vectors(v):
+    """Vectors (..., d) padded with zeros to (..., 3), as ParaView expects."""
+    v = np.asarray(v, dtype=float)
+    pad = [(0, 0)] * (v.ndim - 1) + [(0, 3 - v.shape[-1])]
+    return np.pad(v, pad)
 
 
 def _data_format():
@@ -91,9 +93,7 @@ def summary(solution):
 
 def write_summary(solution, path):
     """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
-    with open(path, "w", encoding="utf-8") as f:
-        json.dump(summary(solution), f, indent=1, allow_nan=False)
-        f.write("\n")
+    write_json(path, summary(solution))
 
 
 def contact_facets(problem):

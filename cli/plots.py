@@ -16,19 +16,43 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 
-from .postprocess import (  # noqa: E402
-    along_axis,
+from adhesive_contact.postprocess import (  # noqa: E402
     beta_mean,
-    facet_midpoints,
+    cell_von_mises,
     normal_traction,
-    stress_3x3,
-    tangent_direction,
     tangential_traction,
-    von_mises,
 )
 
 AXES = "xyz"
 DPI = 120
+
+
+def tangent_direction(problem):
+    """The common tangent τ of the contact nodes, or None if the frames differ.
+
+    A straight contact side in 2D has one tangent; labels can then say
+    along which axis a positive σ_τ points."""
+    boundary = problem.boundary
+    if boundary is None or boundary.nodes.size == 0 or problem.dim != 2:
+        return None
+    tau = boundary.frame[:, :, 1]
+    if not np.allclose(tau, tau[0], atol=1e-9):
+        return None
+    return tau[0]
+
+
+def along_axis(points):
+    """The coordinate axis (0, 1, 2) along which points (d, n) spread most."""
+    points = np.asarray(points)
+    if points.shape[1] == 0:
+        return 0
+    return int(np.argmax(points.max(axis=1) - points.min(axis=1)))
+
+
+def facet_midpoints(problem):
+    """Midpoints (d, nf) of the contact facets."""
+    boundary = problem.boundary
+    return problem.mesh.p[:, boundary.facet_nodes].mean(axis=1)
 
 
 def sample_levels(steps, count=5):
@@ -61,7 +85,7 @@ def _title(solution):
 def _deformed_2d(fig, ax, solution, factor):
     mesh = solution.problem.mesh
     p = mesh.p + factor * solution.u[-1].T
-    vm = von_mises(stress_3x3(solution, -1))
+    vm = cell_von_mises(solution, -1)
     tri = Triangulation(p[0], p[1], mesh.t.T)
     image = ax.tripcolor(tri, facecolors=vm, cmap="viridis", shading="flat")
     ax.triplot(tri, color="k", linewidth=0.2, alpha=0.4)
@@ -89,7 +113,7 @@ def _deformed_3d(fig, solution, factor):
     ax = fig.add_subplot(projection="3d")
     p = mesh.p + factor * solution.u[-1].T
     faces = mesh.boundary_facets()
-    vm = von_mises(stress_3x3(solution, -1))[mesh.f2t[0, faces]]
+    vm = cell_von_mises(solution, -1)[mesh.f2t[0, faces]]
     norm = plt.Normalize(vm.min(), vm.max())
     polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
     ax.add_collection3d(Poly3DCollection(polys, facecolors=plt.cm.viridis(norm(vm)),

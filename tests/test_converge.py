@@ -8,12 +8,12 @@ import shutil
 from pathlib import Path
 from types import SimpleNamespace
 
-import adhesive_contact_cli.converge as converge_module
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 
+import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, parse_scene
 from adhesive_contact.convergence import default_reference_refinement, run_reference
 

@@ -1,0 +1,25 @@
+"""Studies: sets of independent runs of scene variants with a stable identity.
+
+:mod:`.study` is the layer every kind of study shares (the identity in
+``study.json``, one saved record per finished run, computing only what is
+missing); :mod:`.pool` runs the runs in this process, in local worker
+processes or on any executor; :mod:`.convergence` is the convergence study
+in h, k or both, :mod:`.sweep` a parameter sweep.
+"""
+
+from .convergence import ConvergenceResult, ConvergenceStudy
+from .pool import execute
+from .study import (
+    RunFailed,
+    RunStore,
+    Study,
+    StudyError,
+    StudyFolderError,
+    StudyMismatch,
+    study_document,
+)
+from .sweep import Sweep, SweepResult, parse_assignment
+
+__all__ = ["ConvergenceResult", "ConvergenceStudy", "execute", "RunFailed", "RunStore",
+           "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document",
+           "Sweep", "SweepResult", "parse_assignment"]

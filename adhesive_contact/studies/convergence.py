@@ -1,0 +1,379 @@
+"""Convergence studies in h, k or both, kept in a folder (MODEL.md §7).
+
+The computation of one level and of the fine reference is
+:mod:`adhesive_contact.convergence`; :class:`ConvergenceStudy` is the
+study on top of :class:`~adhesive_contact.studies.study.Study`. Its folder:
+
+- ``study.json``: the resolved scene (level 0), param, levels, reference
+  kind, ref_h and ref_k, and the sha256 of exactly that;
+- ``reference.npz`` (reference ``"fine"``): the reference run's t, u, beta,
+  facets, its refine and steps and its wall time, saved once computed;
+- ``levels/level_NN.json``: one record of
+  :func:`~adhesive_contact.convergence.run_level` per finished level;
+- ``errors.csv`` and ``rates.json`` (:func:`results`): rewritten from the
+  saved records at the end of every completed run.
+
+From Python::
+
+    from pathlib import Path
+    from adhesive_contact.studies import ConvergenceStudy
+
+    study = ConvergenceStudy(Path("scene.toml"), param="h", levels=4,
+                             reference="exact", folder="out")
+    result = study.run(jobs=2)
+    result.document["rates"]     # {"u": ..., "beta": ..., "E": ...}
+"""
+
+import csv
+import math
+import zipfile
+from dataclasses import dataclass, replace
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from ..convergence import (
+    PARAMS,
+    Reference,
+    default_reference_refinement,
+    pairwise_rates,
+    rates,
+    reference_scene,
+    run_level,
+    run_reference,
+    with_discretisation,
+)
+from ..mesh import build_mesh
+from ..scene import scene_from_dict
+from ..storage import write_atomic, write_json
+from .pool import attempt
+from .study import RunFailed, Study, StudyError, scene_source
+
+REFERENCE = "reference.npz"
+LEVELS = "levels"
+FLOAT_KEYS = ("h", "k", "err_u", "err_beta", "E", "seconds")
+RECORD_KEYS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "seconds")
+CSV_COLUMNS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
+               "seconds")
+#: MODEL.md §7: a rate is fitted over at least 4 levels
+MEANINGFUL_LEVELS = 4
+#: the largest run a study may ask for (dofs); beyond it the set-up alone
+#: (a Schur complement onto Γ_C) takes hours and tens of GB on a workstation
+MAX_DOFS = 2_000_000
+
+
+# ---------------------------------------------------------------- the reference file
+
+
+def save_reference(path, reference):
+    """``reference.npz``: the arrays of a :class:`Reference`, its refine, steps, seconds."""
+    arrays = {"t": reference.t, "u": reference.u, "beta": reference.beta,
+              "facets": np.asarray(reference.facets, dtype=np.int64),
+              "refine": np.int64(reference.scene.mesh.refine),
+              "steps": np.int64(reference.scene.steps),
+              "seconds": np.float64(reference.seconds)}
+    write_atomic(path, lambda f: np.savez_compressed(f, **arrays), binary=True)
+
+
+def load_reference(path, scene, arrays=True):
+    """The saved :class:`Reference` of reference scene ``scene``; None when
+    ``path`` is missing, unreadable or of another refine or number of steps.
+
+    With ``arrays=False`` only its seconds are read (t, u, beta, facets None):
+    a study whose levels are all saved needs no more."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path) as data:
+            if int(data["refine"]) != scene.mesh.refine or int(data["steps"]) != scene.steps:
+                return None
+            seconds = float(data["seconds"])
+            if not arrays:
+                return Reference(scene, None, None, None, None, seconds)
+            if data["t"].shape != (scene.steps + 1,) or data["u"].shape[0] != scene.steps + 1:
+                return None
+            return Reference(scene, data["t"], data["u"], data["beta"], data["facets"],
+                             seconds)
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
+
+
+# ---------------------------------------------------------------- results
+
+
+def results(records, param, reference_info):
+    """The ``rates.json`` document.
+
+    Firm keys: ``{"param", "levels": [{"h", "k", "dofs", "err_u", "err_beta",
+    "E", "seconds", ...}], "rates": {"u", "beta", "E"}}``; each level also
+    has its level, steps, refine, the pairwise rate_E and its Newton
+    iterations, and ``"reference"`` describes the reference."""
+    pairwise = pairwise_rates(records, param)
+    levels = []
+    for record, rate in zip(records, pairwise):
+        levels.append({key: record[key] for key in ("h", "k", "dofs", "err_u", "err_beta",
+                                                     "E", "seconds")}
+                      | {"level": record["level"], "steps": record["steps"],
+                         "refine": record.get("refine"), "rate_E": rate,
+                         "newton_iterations": record.get("newton_iterations")})
+    return {"param": param, "levels": levels, "rates": rates(records, param),
+            "reference": reference_info}
+
+
+def error_rows(document):
+    """The rows of ``errors.csv`` (:data:`CSV_COLUMNS`), one per level: floats
+    as repr, None (a rate_E on the first level, a NaN) as an empty cell."""
+    return [["" if row[key] is None else
+             (repr(float(row[key])) if isinstance(row[key], float) else row[key])
+             for key in CSV_COLUMNS] for row in document["levels"]]
+
+
+def write_errors_csv(path, document):
+    """``errors.csv``: a header of :data:`CSV_COLUMNS`, then :func:`error_rows`."""
+    def write(f):
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(CSV_COLUMNS)
+        writer.writerows(error_rows(document))
+    write_atomic(path, write)
+
+
+# ---------------------------------------------------------------- in a worker
+
+
+def _setup(source, base, param, levels, ref_h, ref_k, reference):
+    """A worker's state: the scene parsed once (with the study's level-0
+    refine and steps) and the reference (sent without its scene) given its
+    scene back."""
+    scene = with_discretisation(scene_from_dict(source), *base)
+    if reference is not None:
+        reference = replace(reference, scene=reference_scene(scene, param, levels, ref_h, ref_k))
+    return SimpleNamespace(scene=scene, param=param, reference=reference)
+
+
+def _compute_level(state, level):
+    return run_level(state.scene, state.param, level, state.reference)
+
+
+# ---------------------------------------------------------------- the study
+
+
+@dataclass
+class ConvergenceResult:
+    """What :meth:`ConvergenceStudy.run` found.
+
+    Attributes
+    ----------
+    document : dict, the ``rates.json`` document (:func:`results`)
+    records : list of the level records, by level
+    computed : list of the levels computed by this run (the others were loaded)
+    reference_loaded : True when the fine reference was read from the
+        folder, False when computed now, None for an exact reference
+    files : names of the result files written (errors.csv, rates.json)
+    """
+
+    document: dict
+    records: list
+    computed: list
+    reference_loaded: object
+    files: list
+
+
+class ConvergenceStudy(Study):
+    """A convergence study of a scene in h, k or both, kept in ``folder``.
+
+    Parameters
+    ----------
+    scene : str, os.PathLike or dict
+        TOML text, a path of a TOML file, or a decoded TOML document.
+    param : {"h", "k", "hk"}
+        Refine in space (one uniform refinement per level), in time (the
+        step halved per level) or both.
+    levels : int >= 2
+        Number of levels (a least-squares rate is meaningful over >= 4).
+    reference : {"exact", "fine"}, optional
+        The scene's exact solution, or a fine reference run; default exact
+        if the scene has an [exact] table, else fine.
+    folder : path of the study's folder
+    ref_h, ref_k : int, optional
+        The fine reference has ``ref_h`` more mesh refinements and
+        ``2**ref_k`` times the steps of the finest level
+        (default :func:`~adhesive_contact.convergence.default_reference_refinement`);
+        only with ``reference="fine"``.
+    refine, steps : int, optional
+        Mesh refinement and steps of level 0 instead of the scene's.
+    scene_file : str, optional
+        Recorded in ``study.json`` (not part of the identity); the path by
+        default when ``scene`` is one.
+
+    Raises
+    ------
+    SceneError for a bad scene; StudyError naming the argument
+    (``key``) for a study that cannot be run. Nothing is written before
+    :meth:`run`.
+    """
+
+    kind = "convergence study"
+    runs_folder = LEVELS
+    compute = _compute_level
+
+    def __init__(self, scene, param, levels=5, reference=None, *, folder, ref_h=None,
+                 ref_k=None, refine=None, steps=None, scene_file=None):
+        super().__init__(folder)
+        if scene_file is None and not isinstance(scene, (str, dict)):
+            scene_file = str(scene)
+        self.scene_file = scene_file
+        self.source = scene_source(scene)
+        given = scene_from_dict(self.source)
+        if param not in PARAMS:
+            raise StudyError("param", f"must be one of {', '.join(PARAMS)}, got {param!r}")
+        if not isinstance(levels, int) or levels < 2:
+            raise StudyError("levels", f"must be an integer >= 2, got {levels!r}")
+        self.base = (refine, steps)
+        self.scene = with_discretisation(given, refine, steps)
+        self.param, self.levels = param, levels
+        if reference is None:
+            reference = "exact" if self.scene.exact is not None else "fine"
+        if reference not in ("exact", "fine"):
+            raise StudyError("reference", f"must be exact or fine, got {reference!r}")
+        if reference == "exact" and self.scene.exact is None:
+            raise StudyError("reference", "'exact' needs an [exact] table in the scene; "
+                             "allowed here: fine")
+        if reference == "fine" and self.scene.dim == 3 and self.scene.has_contact_terms:
+            raise StudyError("reference", "'fine' carries β between nested meshes in 2D "
+                             "only; allowed for this 3D scene: exact (add an [exact] table)")
+        if reference == "exact" and (ref_h is not None or ref_k is not None):
+            raise StudyError("ref_h/ref_k", "refine the fine reference; allowed only with "
+                             "reference fine (the reference here is the exact solution)")
+        if reference == "fine":
+            dh, dk = default_reference_refinement(param)
+            ref_h = dh if ref_h is None else ref_h
+            ref_k = dk if ref_k is None else ref_k
+        self.reference, self.ref_h, self.ref_k = reference, ref_h, ref_k
+        largest = self.largest_dofs(given)
+        if largest > MAX_DOFS:
+            what = ("the fine reference" if reference == "fine" and ref_h
+                    else "the finest level")
+            raise StudyError("levels", f"{what} would have about {largest:.2g} dofs (more "
+                             f"than {MAX_DOFS:.0e}); use fewer levels, a smaller reference "
+                             "refinement, or a coarser mesh for level 0")
+
+    # -- identity and runs
+
+    def identity(self):
+        return {"scene": self.scene.resolved, "param": self.param, "levels": self.levels,
+                "reference": self.reference, "ref_h": self.ref_h, "ref_k": self.ref_k}
+
+    def keys(self):
+        return list(range(self.levels))
+
+    def record_name(self, level):
+        return f"level_{level:02d}.json"
+
+    def valid(self, level, record):
+        return (isinstance(record, dict) and record.get("level") == level
+                and all(key in record for key in RECORD_KEYS))
+
+    def load(self):
+        """{level: record} of the saved levels, null errors read back as NaN."""
+        return {level: {**record, **{key: (math.nan if record[key] is None
+                                           else float(record[key])) for key in FLOAT_KEYS}}
+                for level, record in super().load().items()}
+
+    def context(self, reference=None):
+        light = None if reference is None else replace(reference, scene=None)
+        return _setup, (self.source, self.base, self.param, self.levels, self.ref_h,
+                        self.ref_k, light)
+
+    def largest_dofs(self, given=None):
+        """About how many dofs the largest run (finest level or reference) has:
+        the scene's dofs times 2^dim per extra uniform refinement."""
+        given = given if given is not None else scene_from_dict(self.source)
+        dofs = given.dim * build_mesh(given.mesh).p.shape[1]
+        growth = 2 ** given.dim
+        extra = (self.scene.mesh.refine - given.mesh.refine
+                 + (self.levels - 1 if self.param in ("h", "hk") else 0)
+                 + (self.ref_h if self.reference == "fine" else 0))
+        return dofs * growth ** extra
+
+    @property
+    def reference_scene(self):
+        """The scene of the fine reference run (None for an exact reference)."""
+        if self.reference != "fine":
+            return None
+        return reference_scene(self.scene, self.param, self.levels, self.ref_h, self.ref_k)
+
+    # -- running
+
+    def _fine_reference(self, arrays, progress):
+        """(reference, loaded): from ``reference.npz``, else run and saved."""
+        rscene = self.reference_scene
+        fine = load_reference(self.folder / REFERENCE, rscene, arrays=arrays)
+        if fine is not None:
+            return fine, True
+        total = rscene.steps + 1
+        progress("reference", 0, total)
+
+        def compute(state, key):
+            return run_reference(self.scene, self.param, self.levels, self.ref_h, self.ref_k,
+                                 progress=lambda n, N: progress("reference", n + 1, total))
+
+        _, fine, message = attempt(compute, None, "reference")
+        if message is not None:
+            raise RunFailed("reference run", message)
+        save_reference(self.folder / REFERENCE, fine)
+        return fine, False
+
+    def run(self, jobs=1, executor=None, as_completed=None, progress=None):
+        """Compute what is missing, then write ``errors.csv`` and ``rates.json``.
+
+        Parameters
+        ----------
+        jobs, executor, as_completed : how the levels run
+            (:func:`~adhesive_contact.studies.pool.execute`); the fine
+            reference runs first, alone, in this process.
+        progress : callable (stage, done, total), optional
+            Called with stage ``"reference"`` (done = time levels of the
+            reference run, from 0) and ``"levels"`` (done = finished levels,
+            first with those loaded from the folder).
+
+        Returns
+        -------
+        ConvergenceResult
+
+        Raises
+        ------
+        StudyFolderError, StudyMismatch
+            The folder is not this study's (nothing written).
+        RunFailed
+            A level or the reference did not converge; the finished levels
+            stay saved.
+        OSError
+            The folder cannot be written.
+        """
+        progress = progress or (lambda stage, done, total: None)
+        self.create({"scene_file": self.scene_file} if self.scene_file else None)
+        done = self.load()
+        missing = [level for level in self.keys() if level not in done]
+        fine, loaded, info = None, None, {"kind": self.reference}
+        if self.reference == "fine":
+            fine, loaded = self._fine_reference(bool(missing), progress)
+            rscene = fine.scene
+            info |= {"ref_h": self.ref_h, "ref_k": self.ref_k, "refine": rscene.mesh.refine,
+                     "steps": rscene.steps, "k": rscene.k, "seconds": fine.seconds}
+        progress("levels", len(done), self.levels)
+        setup, args = self.context(fine)
+        computed = self.run_missing(
+            done, jobs=jobs, executor=executor, as_completed=as_completed,
+            on_record=lambda level, record: progress("levels", len(done), self.levels),
+            label=lambda level: f"level {level}", context=(setup, args))
+        records = [done[level] for level in self.keys()]
+        if self.reference == "fine":
+            info["h"] = records[-1]["h"] / 2 ** self.ref_h
+        document = results(records, self.param, info)
+        files = ["errors.csv", "rates.json"]
+        write_errors_csv(self.folder / files[0], document)
+        write_json(self.folder / files[1], document)
+        return ConvergenceResult(document, records, computed, loaded, files)
+

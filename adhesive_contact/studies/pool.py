@@ -1,0 +1,124 @@
+"""Running the runs of a study: in this process, in local worker processes,
+or on any executor.
+
+A run is ``compute(state, key)`` returning a plain-JSON record; ``state``
+is what ``setup(*args)`` builds (the parsed scene, a reference solution)
+once per process and keeps for every run that process computes. Workers
+compute and return plain data; only the calling process writes files
+(``on_record``), one finished run at a time.
+
+The executor is pluggable: anything with ``submit(fn, *args)`` returning
+futures, with an ``as_completed(futures)`` yielding them as they finish
+(:mod:`concurrent.futures`, or a ``dask.distributed`` client and its
+``as_completed``).
+"""
+
+import multiprocessing
+import threading
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import as_completed as futures_completed
+
+from ..scheme import StepFailure
+
+#: per process: token -> (setup, args) installed by the pool initializer,
+#: and token -> state built from it on first use
+_CONTEXTS = {}
+_STATES = {}
+_LOCK = threading.Lock()   # threaded workers build a state once too
+
+
+def _install(token, setup, args):
+    """Pool initializer: remember how to build the state (built on first use)."""
+    _CONTEXTS[token] = (setup, args)
+
+
+def _state(token, context=None):
+    """The process's state for ``token``, built once from its context."""
+    with _LOCK:
+        if token not in _STATES:
+            setup, args = context if context is not None else _CONTEXTS[token]
+            _STATES.clear()   # one study at a time per process
+            _STATES[token] = setup(*args)
+        return _STATES[token]
+
+
+def attempt(compute, state, key):
+    """(key, record, None), or (key, None, message) when the run's time loop
+    failed (a step solve that did not converge); the one place a failure of
+    the scheme is caught."""
+    try:
+        return key, compute(state, key), None
+    except StepFailure as err:
+        return key, None, str(err)
+
+
+def run_task(token, compute, key, context=None):
+    """One run in a worker: ``context`` (setup, args) is sent with each task
+    by a generic executor and installed once per process by the local pool."""
+    return attempt(compute, _state(token, context), key)
+
+
+def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
+            as_completed=None):
+    """Compute the runs ``keys``; call ``on_record(key, record)`` as each finishes.
+
+    Parameters
+    ----------
+    keys : list of the runs to compute
+    compute : module-level function (state, key) -> record
+    context : (setup, args), setup(*args) -> state (both must pickle for
+        worker processes)
+    on_record : called in this process, one finished run at a time
+    token : str naming the study (its sha256): a worker process keeps the
+        state of one token
+    jobs : int
+        Without ``executor``: 1 computes in this process (state built once
+        here); more starts that many local worker processes (spawned, each
+        reused for many runs, the state built once per process).
+    executor : object with ``submit(fn, *args)`` returning futures, optional
+        Runs are submitted to it (``jobs`` ignored); its workers build the
+        state once per process.
+    as_completed : callable yielding finished futures, optional
+        Default :func:`concurrent.futures.as_completed`; give
+        ``distributed.as_completed`` with a dask client.
+
+    Returns
+    -------
+    None, or (key, message) of the first run that failed: no other run is
+    started after it, and the runs already running are finished and passed
+    to ``on_record``.
+    """
+    keys = list(keys)
+    if not keys:
+        return None
+    if executor is None and (jobs == 1 or len(keys) == 1):
+        state = context[0](*context[1])
+        for key in keys:
+            key, record, message = attempt(compute, state, key)
+            if message is not None:
+                return key, message
+            on_record(key, record)
+        return None
+    if executor is not None:
+        futures = [executor.submit(run_task, token, compute, key, context) for key in keys]
+        return _collect(futures, as_completed or futures_completed, on_record)
+    with ProcessPoolExecutor(max_workers=min(jobs, len(keys)),
+                             mp_context=multiprocessing.get_context("spawn"),
+                             initializer=_install, initargs=(token, *context)) as pool:
+        futures = [pool.submit(run_task, token, compute, key) for key in keys]
+        return _collect(futures, as_completed or futures_completed, on_record)
+
+
+def _collect(futures, as_completed, on_record):
+    failure = None
+    for future in as_completed(futures):
+        if future.cancelled():
+            continue
+        key, record, message = future.result()
+        if message is None:
+            on_record(key, record)
+        elif failure is None:
+            failure = (key, message)
+            for other in futures:
+                other.cancel()
+    return failure

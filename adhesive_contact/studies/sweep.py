@@ -1,0 +1,412 @@
+"""Parameter sweeps: one scene run for every combination of a few settings.
+
+A setting is a dotted TOML key and its values, e.g.
+``("contact.normal.c", [1e2, 1e3])`` or ``("time.steps", [10, 20])``; an
+integer part indexes an array of tables (``contact.friction.0.mu``). The
+variants are the grid of all combinations (``mode="grid"``, the last key
+varying fastest) or the settings taken in step (``"zip"``, equal lengths).
+Every variant's scene is validated (parsed and discretised) before
+anything runs.
+
+A run that fails (a step solve that did not converge) is a result, not an
+error: its record says where it stopped. The folder:
+
+- ``study.json``: the resolved base scene, the settings and the mode, and
+  the sha256 of that (another sweep in the folder is refused);
+- ``runs/run_NNN.json``: one record per finished run (:func:`run_variant`);
+- ``runs.csv``: one row per run (:data:`CSV_COLUMNS`), rewritten at the end.
+
+From Python::
+
+    from pathlib import Path
+    from adhesive_contact.studies import Sweep
+
+    sweep = Sweep(Path("scene.toml"), [("contact.normal.c", [1e2, 1e3]),
+                                       ("time.steps", [10, 20])], folder="out")
+    result = sweep.run(jobs=2)      # result.records: one dict per run
+"""
+
+import copy
+import csv
+import itertools
+import json
+import re
+import resource
+import time
+import tomllib
+from dataclasses import dataclass
+
+from .. import SceneError, build_problem, scene_from_dict, solve
+from ..postprocess import beta_mean, contact_states
+from ..storage import plain, write_atomic
+from .study import Study, StudyError, scene_source
+
+MODES = ("grid", "zip")
+OUTCOMES = ("ok", "failed")
+#: the measured columns of runs.csv, after "run" and the swept keys
+MEASURED = ("outcome", "failed_step", "failed_t", "residual", "seconds", "newton_total",
+            "newton_max", "worker_peak_rss_mib", "beta_min_T", "beta_mean_T",
+            "max_un_minus_g", "separated_T", "on_wall_T", "compliance_T", "stick_T",
+            "slip_T", "normal_force_T")
+_BARE = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
+
+
+# ---------------------------------------------------------------- settings
+
+
+def show(value):
+    """A value as it is written in TOML (``1000.0``, ``true``, ``"gauss"``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(show(v) for v in value) + "]"
+    return repr(value)
+
+
+def split_values(text):
+    """Split ``"1e2,1e3"`` at the commas outside brackets and quotes."""
+    parts, depth, quote, start = [], 0, None, 0
+    for i, ch in enumerate(text):
+        if quote:
+            if ch == quote:
+                quote = None
+        elif ch in "\"'":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+        elif ch == "," and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    parts.append(text[start:])
+    return [p.strip() for p in parts]
+
+
+def parse_value(text):
+    """A TOML value (``1e3``, ``10``, ``true``, ``"gauss"``, ``[8, 4]``); a bare
+    word that is not TOML (``gauss``) is taken as a string.
+
+    Raises ValueError naming the text when it is neither."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        if _BARE.fullmatch(text):
+            return text
+        raise ValueError(f"{text!r} is not a TOML value (a number, true/false, "
+                         "a quoted string or an array)") from None
+
+
+def parse_assignment(text):
+    """``"KEY=V1,V2,..."`` -> (key, [values]) with TOML values (:func:`parse_value`).
+
+    Raises :class:`StudyError` (key ``"set"``, or the key) for a malformed one."""
+    key, sep, values = text.partition("=")
+    key = key.strip()
+    if not sep or not key or not values.strip():
+        raise StudyError("set", f"{text!r}: expected KEY=V1,V2,... (a dotted TOML key, "
+                         "comma-separated values)")
+    if not all(part for part in key.split(".")):
+        raise StudyError("set", f"{key!r}: empty part in the dotted key")
+    parsed = []
+    for item in split_values(values):
+        try:
+            parsed.append(parse_value(item))
+        except ValueError as err:
+            raise StudyError(f"set {key}", str(err)) from None
+    return key, parsed
+
+
+def with_value(document, key, value):
+    """A deep copy of the TOML ``document`` with dotted ``key`` set to ``value``.
+
+    Missing tables on the way are created; an integer part indexes an
+    array of tables. Raises ValueError when a part is neither."""
+    out = copy.deepcopy(document)
+    node, parts = out, key.split(".")
+    for depth, part in enumerate(parts):
+        last = depth == len(parts) - 1
+        where = ".".join(parts[:depth]) or "the scene"
+        if isinstance(node, list):
+            if not (part.isdigit() and int(part) < len(node)):
+                raise ValueError(f"{where} is an array of {len(node)} tables; "
+                                 f"{part!r} is not an index into it")
+            index = int(part)
+        elif isinstance(node, dict):
+            index = part
+        else:
+            raise ValueError(f"{where} is a value, not a table")
+        if last:
+            node[index] = value
+        else:
+            if isinstance(node, dict) and index not in node:
+                node[index] = {}
+            node = node[index]
+    return out
+
+
+def variants(settings, mode="grid"):
+    """The variants of a sweep: a list of {key: value}, in run order.
+
+    Raises :class:`StudyError` for an unknown mode, no settings, a key set
+    twice or (zip) lists of different lengths."""
+    if mode not in MODES:
+        raise StudyError("mode", f"must be grid or zip, got {mode!r}")
+    settings = [(key, list(values)) for key, values in settings]
+    if not settings:
+        raise StudyError("set", "give at least one KEY=V1,V2,...")
+    keys = [key for key, _ in settings]
+    for key, values in settings:
+        if keys.count(key) > 1:
+            raise StudyError(f"set {key}", "set twice; give all its values in one --set")
+        if not values:
+            raise StudyError(f"set {key}", "no values")
+    if mode == "zip":
+        length = len(settings[0][1])
+        for key, values in settings[1:]:
+            if len(values) != length:
+                raise StudyError(f"set {key}", f"has {len(values)} values, "
+                                 f"{settings[0][0]} has {length}; zip needs equal lengths")
+        combos = zip(*(values for _, values in settings))
+    else:
+        combos = itertools.product(*(values for _, values in settings))
+    return [dict(zip(keys, combo)) for combo in combos]
+
+
+def variant_document(document, values):
+    """The TOML document of one variant: ``document`` with every setting applied."""
+    for key, value in values.items():
+        document = with_value(document, key, value)
+    return document
+
+
+# ---------------------------------------------------------------- one run
+
+
+def solve_or_failure(problem):
+    """(solution, None), or (None, failure) when a step did not converge or
+    gave an invalid state: the one place a sweep calls the scheme."""
+    solution = solve(problem)
+    return (solution, None) if solution.success else (None, solution.failure)
+
+
+def peak_rss_mib():
+    """Peak resident set size of this process so far (MiB), from getrusage.
+
+    In a worker process reused for several runs it is the peak over every
+    run that process has done, not of the last one alone."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def _at_T(values):
+    return None if values is None else values[-1]
+
+
+def run_variant(document, values):
+    """Build and solve one variant; its record (plain JSON).
+
+    Keys: ``values`` ({key: value}), ``outcome`` ("ok" or "failed"),
+    ``failure`` (None, or {step, t, residual, iterations, message}),
+    ``seconds`` (wall time of build and solve), ``newton_total`` and
+    ``newton_max`` (Newton iterations, summed and max over the steps),
+    ``residual`` (max final relative residual over the steps; for a failure
+    the one reached), ``worker_peak_rss_mib`` (:func:`peak_rss_mib`), and
+    at the final time T: ``beta_min_T``, ``beta_mean_T`` (weighted by the
+    facet lengths), the contact-node counts ``separated_T``, ``on_wall_T``,
+    ``compliance_T``, ``stick_T``, ``slip_T`` (None without friction) and
+    ``normal_force_T`` (the total normal force of Γ_C on the body, positive
+    in compression); ``max_un_minus_g`` is max over all levels and contact
+    nodes of u_ν − g (None without a wall). A failed run has None for what
+    needs the solution.
+    """
+    t0 = time.perf_counter()
+    problem = build_problem(scene_from_dict(variant_document(document, values)))
+    solution, failure = solve_or_failure(problem)
+    record = {"values": values, "seconds": time.perf_counter() - t0,
+              "worker_peak_rss_mib": peak_rss_mib()}
+    if failure is not None:
+        result = failure.result
+        return plain(record | {
+            "outcome": "failed",
+            "failure": {"step": failure.n, "t": failure.t, "residual": result.residual,
+                        "iterations": result.nit, "message": str(failure)},
+            "residual": result.residual})
+    states = {key: mask[-1].sum() for key, mask in contact_states(solution).items()}
+    has_beta = solution.beta.shape[1] > 0
+    return plain(record | {
+        "outcome": "ok", "failure": None,
+        "residual": solution.residual.max(),
+        "newton_total": solution.iterations.sum(), "newton_max": solution.iterations.max(),
+        "beta_min_T": solution.beta[-1].min() if has_beta else None,
+        "beta_mean_T": _at_T(beta_mean(solution)),
+        "max_un_minus_g": solution.gap_violation().max(),
+        **{f"{key}_T": states.get(key) for key in ("separated", "on_wall", "compliance",
+                                                  "stick", "slip")},
+        "normal_force_T": solution.total_normal_force()[-1]})
+
+
+def _setup(document, runs):
+    return document, runs
+
+
+def _compute_run(state, key):
+    document, runs = state
+    return {"run": key} | run_variant(document, runs[key])
+
+
+# ---------------------------------------------------------------- rows
+
+
+def csv_columns(keys):
+    """The columns of runs.csv: run, the swept keys, then :data:`MEASURED`."""
+    return ["run", *keys, *MEASURED]
+
+
+def run_row(record, keys):
+    """One runs.csv row (a dict by column) of a run record."""
+    failure = record.get("failure") or {}
+    row = {"run": record["run"], **{key: record["values"][key] for key in keys}}
+    for column in MEASURED:
+        row[column] = record.get(column)
+    row.update(failed_step=failure.get("step"), failed_t=failure.get("t"))
+    return row
+
+
+def _cell(value):
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, (list, dict)):
+        return str(value)
+    return value
+
+
+def write_runs_csv(path, rows, keys):
+    """``runs.csv``: a header of :func:`csv_columns`, one row per run; None empty."""
+    columns = csv_columns(keys)
+
+    def write(f):
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(columns)
+        for row in rows:
+            writer.writerow([_cell(row[column]) for column in columns])
+    write_atomic(path, write)
+
+
+# ---------------------------------------------------------------- the study
+
+
+@dataclass
+class SweepResult:
+    """What :meth:`Sweep.run` found: ``records`` (one per run, in run order),
+    ``rows`` (the runs.csv rows), ``computed`` (runs computed now) and
+    ``files`` (names written)."""
+
+    records: list
+    rows: list
+    computed: list
+    files: list
+
+
+class Sweep(Study):
+    """A parameter sweep of a scene, kept in ``folder``.
+
+    Parameters
+    ----------
+    scene : str, os.PathLike or dict
+        TOML text, a path of a TOML file, or a decoded TOML document.
+    settings : sequence of (key, values)
+        Dotted TOML keys and their values (see the module docstring).
+    mode : {"grid", "zip"}
+    folder : path of the sweep's folder
+
+    Raises
+    ------
+    SceneError for a bad base scene; StudyError naming the setting
+    (``key`` ``"set KEY"``) when a variant is not a valid scene, before
+    anything runs or is written. ``warnings`` lists (variant, warning) of
+    what the theory does not cover.
+    """
+
+    kind = "parameter sweep"
+    runs_folder = "runs"
+    compute = _compute_run
+
+    def __init__(self, scene, settings, mode="grid", *, folder):
+        super().__init__(folder)
+        self.source = scene_source(scene)
+        self.base = scene_from_dict(self.source)
+        self.settings = [(key, list(values)) for key, values in settings]
+        self.mode = mode
+        self.runs = variants(self.settings, mode)
+        self.keys_set = [key for key, _ in self.settings]
+        self.warnings = []
+        for index, values in enumerate(self.runs):
+            problem = self._check(values)
+            self.warnings += [(index, str(w)) for w in problem.warnings()]
+
+    def _check(self, values):
+        """The problem of one variant, or StudyError naming the setting at fault."""
+        document = self.source
+        for key, value in values.items():
+            try:
+                document = with_value(document, key, value)
+            except ValueError as err:
+                raise StudyError(f"set {key}", str(err)) from None
+        try:
+            return build_problem(scene_from_dict(document))
+        except SceneError as err:
+            if err.key in values:
+                reason = str(err).removeprefix(f"{err.key}: ")
+                raise StudyError(f"set {err.key}={show(values[err.key])}", reason) from None
+            where = ", ".join(f"{k}={show(v)}" for k, v in values.items())
+            raise StudyError("set", f"the variant {where} is not a valid scene: {err}") \
+                from None
+
+    def identity(self):
+        return {"scene": self.base.resolved, "set": [[k, v] for k, v in self.settings],
+                "mode": self.mode}
+
+    def keys(self):
+        return list(range(len(self.runs)))
+
+    def record_name(self, key):
+        return f"run_{key:03d}.json"
+
+    def valid(self, key, record):
+        return (isinstance(record, dict) and record.get("run") == key
+                and record.get("outcome") in OUTCOMES
+                and record.get("values") == plain(self.runs[key]))
+
+    def context(self):
+        return _setup, (self.source, self.runs)
+
+    def run(self, jobs=1, executor=None, as_completed=None, progress=None):
+        """Compute the runs not saved yet, then write ``runs.csv``.
+
+        ``jobs``, ``executor`` and ``as_completed`` as in
+        :func:`~adhesive_contact.studies.pool.execute`; ``progress(stage,
+        done, total)`` is called with stage ``"runs"`` (first with the runs
+        loaded from the folder, then after each finished run).
+
+        Returns :class:`SweepResult`. Raises StudyFolderError or
+        StudyMismatch when the folder is not this sweep's, OSError when it
+        cannot be written; failed runs are results.
+        """
+        progress = progress or (lambda stage, done, total: None)
+        self.create()
+        done = self.load()
+        total = len(self.runs)
+        progress("runs", len(done), total)
+        computed = self.run_missing(
+            done, jobs=jobs, executor=executor, as_completed=as_completed,
+            on_record=lambda key, record: progress("runs", len(done), total),
+            label=lambda key: f"run {key}")
+        records = [done[key] for key in self.keys()]
+        rows = [run_row(record, self.keys_set) for record in records]
+        write_runs_csv(self.folder / "runs.csv", rows, self.keys_set)
+        return SweepResult(records, rows, computed, ["runs.csv"])
+

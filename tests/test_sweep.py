@@ -1,0 +1,273 @@
+"""Tests for ``adhcontact sweep`` and :mod:`adhesive_contact.studies.sweep`:
+settings parsed as TOML values, every variant validated before anything
+runs, failed runs as rows, runs.csv against direct solves, resume."""
+
+import csv
+import inspect
+import shutil
+import tomllib
+
+import numpy as np
+import pytest
+from adhesive_contact_cli.main import main
+from click.testing import CliRunner
+
+import adhesive_contact.studies.sweep as sweep_module
+from adhesive_contact import StepFailure, build_problem, parse_scene, scene_from_dict, solve
+from adhesive_contact.postprocess import beta_mean
+from adhesive_contact.studies import StudyError, Sweep, parse_assignment
+from adhesive_contact.studies.sweep import split_values, variants, with_value
+
+# an 8x4 block hanging from its top, pulled down onto a wall: with one
+# Newton iteration allowed, the stiff layer (c = 5000) fails at step 1
+SCENE = """\
+title = "test block"
+dim = 2
+
+[mesh]
+domain = "rectangle"
+size = [2.0, 1.0]
+cells = [8, 4]
+
+[boundary]
+dirichlet = ["top"]
+contact = ["bottom"]
+
+[material]
+E = 1000.0
+nu = 0.3
+
+[memory]
+kernel = "prony"
+terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
+
+[loads]
+body = ["0", "-400*t"]
+
+[contact]
+gap = "0.002 + 0.01*(x - 1)**2"
+
+[contact.normal]
+law = "compliance"
+c = 5000.0
+
+[time]
+T = 1.0
+steps = 3
+"""
+
+GRID = ("--set", "contact.normal.c=1e3,5000", "--set", "solver.max_iter=1,50")
+
+
+def runner():
+    if "mix_stderr" in inspect.signature(CliRunner).parameters:
+        return CliRunner(mix_stderr=False)
+    return CliRunner()
+
+
+def run(*args):
+    return runner().invoke(main, ["sweep", *map(str, args)], catch_exceptions=False)
+
+
+def assert_one_line_error(result, code, needle):
+    assert result.exit_code == code, (result.stdout, result.stderr)
+    errors = [line for line in result.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1, result.stderr
+    assert needle in errors[0], errors[0]
+    assert "Traceback" not in result.stderr + result.stdout
+
+
+def read_rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def snapshot(folder):
+    return {str(p.relative_to(folder)): p.read_bytes()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def scene_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("scene") / "block.toml"
+    path.write_text(SCENE)
+    return path
+
+
+@pytest.fixture(scope="module")
+def grid_sweep(scene_file, tmp_path_factory):
+    out = tmp_path_factory.mktemp("grid") / "out"
+    result = run(scene_file, *GRID, "--out", out)
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    return out, result
+
+
+@pytest.fixture
+def counting(monkeypatch):
+    calls = []
+    real = sweep_module.run_variant
+
+    def run_variant(document, values):
+        calls.append(dict(values))
+        return real(document, values)
+
+    monkeypatch.setattr(sweep_module, "run_variant", run_variant)
+    return calls
+
+
+# ---------------------------------------------------------------- settings
+
+
+def test_values_are_toml_scalars_split_outside_brackets():
+    assert parse_assignment("contact.normal.c=1e2,1e3") == ("contact.normal.c", [100.0, 1000.0])
+    assert parse_assignment("time.steps=10, 20") == ("time.steps", [10, 20])
+    assert parse_assignment('mesh.cells=[8, 4],[16,8]') == ("mesh.cells", [[8, 4], [16, 8]])
+    assert parse_assignment('contact.quadrature=nodal,"gauss"') == \
+        ("contact.quadrature", ["nodal", "gauss"])
+    assert parse_assignment("x.flag=true,false")[1] == [True, False]
+    assert split_values('"a,b",[1,2]') == ['"a,b"', "[1,2]"]
+    with pytest.raises(StudyError, match="expected KEY=V1,V2"):
+        parse_assignment("contact.normal.c")
+    with pytest.raises(StudyError, match="'1x' is not a TOML value") as err:
+        parse_assignment("time.steps=10,1x")
+    assert err.value.key == "set time.steps"
+
+
+def test_grid_and_zip_variants():
+    settings = [("a", [1, 2]), ("b", ["x", "y"])]
+    assert variants(settings, "grid") == [{"a": 1, "b": "x"}, {"a": 1, "b": "y"},
+                                          {"a": 2, "b": "x"}, {"a": 2, "b": "y"}]
+    assert variants(settings, "zip") == [{"a": 1, "b": "x"}, {"a": 2, "b": "y"}]
+    with pytest.raises(StudyError, match="set b: has 3 values, a has 2"):
+        variants([("a", [1, 2]), ("b", [1, 2, 3])], "zip")
+    with pytest.raises(StudyError, match="set twice"):
+        variants([("a", [1]), ("a", [2])])
+
+
+def test_with_value_sets_a_copy_and_indexes_arrays_of_tables():
+    doc = {"contact": {"friction": [{"law": "tresca", "mu": 1.0}]}}
+    new = with_value(doc, "contact.friction.0.mu", 0.2)
+    assert new["contact"]["friction"][0]["mu"] == 0.2 and doc["contact"]["friction"][0]["mu"] == 1.0
+    assert with_value(doc, "solver.max_iter", 3)["solver"] == {"max_iter": 3}
+    with pytest.raises(ValueError, match="array of 1 tables; '1' is not an index"):
+        with_value(doc, "contact.friction.1.mu", 0.2)
+    with pytest.raises(ValueError, match="contact.friction.0.mu is a value, not a table"):
+        with_value(doc, "contact.friction.0.mu.x", 0.2)
+
+
+# ---------------------------------------------------------------- the command
+
+
+def test_grid_sweep_rows_match_direct_solves_and_failures_are_rows(grid_sweep):
+    out, result = grid_sweep
+    assert {p.name for p in out.iterdir()} == {
+        "study.json", "runs", "runs.csv", "by_contact.normal.c.png", "by_solver.max_iter.png"}
+    for png in ("by_contact.normal.c.png", "by_solver.max_iter.png"):
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rows = read_rows(out / "runs.csv")
+    assert [(r["contact.normal.c"], r["solver.max_iter"]) for r in rows] == [
+        ("1000.0", "1"), ("1000.0", "50"), ("5000", "1"), ("5000", "50")]
+    base = tomllib.loads(SCENE)
+    for row in rows:
+        doc = with_value(with_value(base, "contact.normal.c", float(row["contact.normal.c"])),
+                         "solver.max_iter", int(row["solver.max_iter"]))
+        problem = build_problem(scene_from_dict(doc))
+        try:
+            solution = solve(problem, raise_on_failure=True)
+        except StepFailure as err:
+            assert row["outcome"] == "failed"
+            assert int(row["failed_step"]) == err.n == 1
+            assert float(row["failed_t"]) == pytest.approx(err.t, rel=1e-15)
+            assert float(row["residual"]) == pytest.approx(err.result.residual, rel=1e-12)
+            assert row["newton_total"] == "" and row["normal_force_T"] == ""
+            continue
+        assert row["outcome"] == "ok" and row["failed_step"] == ""
+        assert int(row["newton_total"]) == solution.iterations.sum()
+        assert int(row["newton_max"]) == solution.iterations.max()
+        assert float(row["normal_force_T"]) == pytest.approx(
+            -solution.contact_force[-1, :, 0].sum(), rel=1e-12)
+        assert float(row["beta_mean_T"]) == pytest.approx(beta_mean(solution)[-1], rel=1e-14)
+        assert int(row["on_wall_T"]) == solution.on_wall[-1].sum() > 0
+        un = solution.frame_displacement[:, :, 0]
+        assert int(row["separated_T"]) == (un[-1] < 0).sum()
+        assert float(row["max_un_minus_g"]) == pytest.approx(
+            (un - problem.gap).max(), abs=1e-15)
+        assert float(row["worker_peak_rss_mib"]) > 10
+        assert float(row["seconds"]) > 0
+    assert [r["outcome"] for r in rows] == ["ok", "ok", "failed", "ok"]
+    assert "3 ok, 1 failed" in result.stdout and "FAILED at step 1" in result.stdout
+
+
+def test_rerun_recomputes_nothing_and_a_lost_run_only_that(grid_sweep, scene_file, tmp_path,
+                                                           counting):
+    out = tmp_path / "out"
+    shutil.copytree(grid_sweep[0], out)
+    before = snapshot(out)
+    result = run(scene_file, *GRID, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert counting == [] and "0 computed now, 4 loaded" in result.stdout
+    assert snapshot(out) == before
+    (out / "runs" / "run_002.json").unlink()
+    result = run(scene_file, *GRID, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert counting == [{"contact.normal.c": 5000, "solver.max_iter": 1}]
+    assert read_rows(out / "runs.csv")[2]["outcome"] == "failed"
+
+
+def test_another_sweep_in_the_folder_exits_2(grid_sweep, scene_file, tmp_path, counting):
+    out = tmp_path / "out"
+    shutil.copytree(grid_sweep[0], out)
+    before = snapshot(out)
+    result = run(scene_file, "--set", "contact.normal.c=1e3,4000", "--set",
+                 "solver.max_iter=1,50", "--out", out)
+    assert_one_line_error(result, 2, "holds a different sweep")
+    assert "(set [[" in result.stderr and counting == []
+    result = run(scene_file, *GRID, "--zip", "--out", out)
+    assert_one_line_error(result, 2, "mode 'grid' there, 'zip' here")
+    assert snapshot(out) == before
+
+
+def test_zip_sweep_in_two_processes(scene_file, tmp_path):
+    out = tmp_path / "out"
+    result = run(scene_file, "--set", "time.steps=2,4", "--set", "contact.normal.c=1e3,2e3",
+                 "--zip", "--jobs", 2, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    rows = read_rows(out / "runs.csv")
+    assert [(r["time.steps"], r["contact.normal.c"]) for r in rows] == [
+        ("2", "1000.0"), ("4", "2000.0")]
+    assert [r["outcome"] for r in rows] == ["ok", "ok"]
+    direct = solve(build_problem(parse_scene(
+        SCENE.replace("steps = 3", "steps = 4").replace("c = 5000.0", "c = 2000.0"))))
+    assert float(rows[1]["normal_force_T"]) == pytest.approx(
+        -direct.contact_force[-1, :, 0].sum(), rel=1e-12)
+    assert int(rows[1]["newton_total"]) == direct.iterations.sum()
+
+
+@pytest.mark.parametrize("sets, needle", [
+    (("contact.normal.cc=1,2",), "--set contact.normal.cc=1: unknown key"),
+    (("contact.normal.c=1e3,-5",), "--set contact.normal.c=-5: "),
+    (("time.steps=2,1x",), "--set time.steps: '1x' is not a TOML value"),
+    (("material.E.x=1",), "--set material.E.x: material.E is a value, not a table"),
+    (("time.steps",), "--set: 'time.steps': expected KEY=V1,V2"),
+    (("time.steps=2,4", "contact.normal.c=1,2,3"), "--set contact.normal.c: has 3 values"),
+])
+def test_bad_settings_exit_2_naming_them_before_anything_runs(scene_file, tmp_path, counting,
+                                                              sets, needle):
+    args = [item for s in sets for item in ("--set", s)]
+    zip_ = ["--zip"] if len(sets) == 2 else []
+    result = run(scene_file, *args, *zip_, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, needle)
+    assert counting == [] and not (tmp_path / "out").exists()
+
+
+def test_sweep_from_python_with_progress(tmp_path, capsys):
+    events = []
+    sweep = Sweep(SCENE, [("solver.max_iter", [1, 50])], folder=tmp_path / "out")
+    result = sweep.run(progress=lambda *event: events.append(event))
+    assert capsys.readouterr() == ("", "")
+    assert events == [("runs", 0, 2), ("runs", 1, 2), ("runs", 2, 2)]
+    assert [r["outcome"] for r in result.records] == ["failed", "ok"]
+    assert result.records[0]["failure"]["step"] == 1
+    assert "did not converge" in result.records[0]["failure"]["message"]
+    assert result.computed == [0, 1]
+    assert np.isfinite(result.rows[1]["normal_force_T"])
