@@ -1,24 +1,28 @@
 """``adhcontact``: the click front end (SPEC.md, "Command line (firm)").
 
-Exit codes: 0 success; 2 a bad scene or bad arguments; 1 a solver that
-did not converge (or outputs that could not be written). Every error is
-one line ``error: ...`` on stderr, and nothing is written to the output
-folder: the scene is parsed, the problem built and the scheme run before
-any file is created, and the outputs appear atomically (a new folder in
-one rename; into an existing one file by file, touching no other file). What the
-theory does not cover for a valid scene (``Problem.warnings()``) is
-reported as one line ``warning: ...`` each on stderr before the time loop,
-and the run goes on.
-"""
+Exit codes: 0 success; 2 a bad scene or bad arguments (nothing written);
+1 a run that failed (a step that did not converge or gave an invalid
+state) or outputs that could not be written; 130 a run stopped by Ctrl-C.
+Every error is one line ``error: ...`` on stderr. The scene is parsed and
+the problem built before any file is created; a run that fails or is
+interrupted writes the levels it finished, marked partial in summary.json
+(``run``). Outputs appear atomically (a new folder in one rename; into an
+existing one file by file, touching no other file). What the theory does
+not cover for a valid scene (``Problem.warnings()``) is reported as one
+line ``warning: ...`` each on stderr before the time loop, and the run
+goes on."""
 
+import contextlib
 import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
 import click
 
-from adhesive_contact import StepFailure
 from adhesive_contact import solve
+from adhesive_contact.scheme import STOPPED
 from adhesive_contact.postprocess import beta_mean
 
 from .common import CliError, echo_warnings, load_scene, read_scene
@@ -66,6 +70,28 @@ def check_out(out):
                        "a writable folder)", 2)
 
 
+@contextlib.contextmanager
+def interruptible():
+    """A block in which Ctrl-C (SIGINT) asks the run to stop at the end of
+    the current step instead of killing it: yields a function that says
+    whether it was pressed. A second Ctrl-C interrupts at once."""
+    pressed = []
+
+    def handler(signum, frame):
+        if pressed:
+            raise KeyboardInterrupt
+        pressed.append(signum)
+
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield lambda: bool(pressed)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 @click.group(cls=OneLineGroup)
 @click.version_option(package_name="adhesive_contact")
 def main():
@@ -91,16 +117,22 @@ def solve_command(scene, out):
     echo_warnings(problem)
 
     with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
-                           file=sys.stderr) as bar:
+                           file=sys.stderr) as bar, interruptible() as interrupted:
+        solution = solve(problem, progress=lambda n, N: bar.update(1) or interrupted())
+    files = []
+    if solution.t.size:   # the levels that converged, partial or not
         try:
-            solution = solve(problem, progress=lambda n, N: bar.update(1),
-                             raise_on_failure=True)
-        except StepFailure as err:
-            raise CliError(str(err), 1) from None
-    try:
-        files = write_outputs(solution, out)
-    except OSError as err:
-        raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+            files = write_outputs(solution, out)
+        except OSError as err:
+            raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+    if solution.status == STOPPED:
+        raise CliError(f"interrupted after step {solution.steps} (t = {solution.t[-1]:g}); "
+                       f"the {solution.t.size} levels done were written to {out}/ "
+                       "(summary.json: run.partial = true)", 130)
+    if not solution.success:
+        kept = (f"The {solution.t.size} levels before it were written to {out}/ "
+                "(summary.json: run.partial = true)." if files else "Nothing was written.")
+        raise CliError(f"{solution.message}. {kept}", 1)
 
     mesh, boundary = problem.mesh, problem.boundary
     contact = ("no contact boundary" if boundary is None else

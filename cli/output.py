@@ -25,6 +25,7 @@ from pathlib import Path
 
 import meshio
 import numpy as np
+from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 
 from adhesive_contact.postprocess import stress_3x3, von_mises
 from adhesive_contact.storage import json_number, write_json
@@ -83,11 +84,30 @@ def summary(solution):
             "contact_facets": 0 if boundary is None else int(boundary.facets.size),
             "contact_nodes": 0 if boundary is None else int(boundary.nodes.size),
         },
+        "run": run_record(solution),
         "smallness": smallness_record(problem),
         "warnings": [str(w) for w in problem.warnings()],
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "iterations": [int(i) for i in solution.iterations],
         "steps": step_records(solution),
+    }
+
+
+def run_record(solution):
+    """How the run ended: ``{"success", "status", "partial", "levels",
+    "message", "failed_step", "failed_t"}``. ``status`` is "complete", "step
+    failed" or "interrupted"; a partial run holds ``levels`` = M + 1 < N + 1
+    time levels, those before the failure or the interruption."""
+    failure = solution.failure
+    return {
+        "success": bool(solution.success),
+        "status": {SUCCESS: "complete", STEP_FAILED: "step failed",
+                   STOPPED: "interrupted"}[solution.status],
+        "partial": bool(solution.t.size < solution.problem.times.size),
+        "levels": int(solution.t.size),
+        "message": " ".join(solution.message.split()),
+        "failed_step": None if failure is None else int(failure.n),
+        "failed_t": None if failure is None else json_number(failure.t),
     }
 
 

@@ -58,7 +58,7 @@ NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
              "iterations", "residual"}
-SUMMARY_KEYS = {"scene", "mesh", "smallness", "warnings", "timings", "iterations", "steps"}
+SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "iterations", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds",
                   "nonconvexity", "step_energy_convex"}
 FILES = {"summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
@@ -273,14 +273,6 @@ def test_stale_outputs_of_a_previous_run_are_removed(tmp_path):
                                                   "deformed.png"}
 
 
-def test_out_that_is_a_file_is_refused_before_the_solve(tmp_path):
-    (tmp_path / "scene.toml").write_text(SCENE)
-    (tmp_path / "taken").write_text("a file")
-    result = run("solve", tmp_path / "scene.toml", "--out", tmp_path / "taken")
-    assert_one_line_error(result, 2, "--out")
-    assert (tmp_path / "taken").read_text() == "a file"
-
-
 def test_default_scene_runs_without_arguments(tmp_path):
     out = tmp_path / "default_out"
     result = run("solve", "--out", out)
@@ -423,16 +415,25 @@ def test_out_that_is_a_file_exits_2(tmp_path):
     assert (tmp_path / "out").read_text() == "a file"
 
 
-def test_solver_failure_exits_1_and_writes_nothing(tmp_path):
+def test_solver_failure_exits_1_and_keeps_the_levels_before_it(tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(edit(SCENE, "[output]", "[solver]\nmax_iter = 1\n\n[output]"))
-    result = run("solve", scene, "--out", tmp_path / "out")
+    out = tmp_path / "out"
+    result = run("solve", scene, "--out", out)
     assert result.exit_code == 1, (result.stdout, result.stderr)
     errors = [line for line in result.stderr.splitlines() if line.startswith("error: ")]
     assert len(errors) == 1, result.stderr
     assert "did not converge" in errors[0] and "step 1" in errors[0]
+    assert "The 1 levels before it were written" in errors[0]
     assert "Traceback" not in result.stderr
-    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
+    summary = strict_json(out / "summary.json")
+    assert summary["run"] == {
+        "success": False, "status": "step failed", "partial": True, "levels": 1,
+        "message": summary["run"]["message"], "failed_step": 1, "failed_t": 1 / 3}
+    assert summary["run"]["message"].startswith("step 1 (t = 0.333333) did not converge")
+    assert len(summary["steps"]) == 1
+    with np.load(out / "solution.npz") as arrays:
+        assert arrays["u"].shape == (1, NPOINTS, 2) and arrays["t"].tolist() == [0.0]
 
 
 def test_the_failing_scene_converges_with_more_iterations(tmp_path):

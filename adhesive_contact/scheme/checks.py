@@ -1,6 +1,8 @@
 """No quiet wrong answers: what every converged level must satisfy.
 
-After each level the loop checks that
+Before each step solve the loop checks that the load of the step is
+finite (a load expression can overflow or divide by zero where it is used),
+and after each level that
 
 - u_n, σ_n and β_n are finite;
 - 0 ≤ β_n ≤ 1 up to round-off (``BETA_SLACK``): the exact β stays in
@@ -37,6 +39,15 @@ class InvalidState(StepFailure):
 def _where(problem, facet):
     x = problem.mesh.p[:, problem.boundary.facet_nodes[:, facet]].mean(axis=1)
     return "(" + ", ".join(f"{c:.4g}" for c in x) + ")"
+
+
+def check_load(n, t, b):
+    """None if the step load b is finite, else the :class:`InvalidState`."""
+    if np.all(np.isfinite(b)):
+        return None
+    return InvalidState(n, t, "the load (body force, tractions and memory history) is not "
+                        "finite (NaN or infinity). Check the load expressions of [loads] "
+                        "for values that overflow or divide by zero at this time")
 
 
 def check_level(problem, level):

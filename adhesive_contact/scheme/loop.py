@@ -9,7 +9,7 @@ rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
 
 import time
 
-from .checks import check_level
+from .checks import check_level, check_load
 from .operators import StepOperators
 from .recorder import HistoryRecorder
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
@@ -44,9 +44,12 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     for n, t in enumerate(problem.times):
         beta = bonding_step(problem, state)                                  # (4.2)
         b, history = step_load(problem, operators, state, n, t)
-        level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
-                                                  beta, history, state.z)   # (4.1)
-        failure = StepFailure(n, t, result) if level is None else check_level(problem, level)
+        failure = check_load(n, t, b)
+        if failure is None:
+            level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
+                                                      beta, history, state.z)   # (4.1)
+            failure = StepFailure(n, t, result) if level is None else check_level(problem,
+                                                                                  level)
         if failure is not None:
             status = STEP_FAILED
             break
