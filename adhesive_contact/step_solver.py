@@ -18,7 +18,8 @@ the orthant-wise treatment of the kink (as in OWL-QN):
 - the stick set: |ξ_a| ≤ ε and |h_a| ≤ κ_a, h_a the gradient without the
   kink — ξ_a is set to 0 and held there;
 - every other node slips with its direction ê_a = ξ_a/|ξ_a| held for the
-  step (or, at ξ_a = 0, ê_a = −(pseudo-gradient)): a trial ξ_a that turns
+  step (or, at ξ_a = 0, ê_a = −(pseudo-gradient), and the Newton step of
+  such a node is projected onto the ray along ê_a): a trial ξ_a that turns
   against ê_a is put to 0, so the sign of ξ/|ξ| cannot flip inside a step;
 - on the free coordinates a Newton step with H = S + ∂²Φ (a modified
   Cholesky when H is indefinite, e.g. under strong slip weakening),
@@ -169,6 +170,13 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             start = at_zero & ~stuck
             ref[start] = -pg[tan[start]] / np.maximum(
                 np.linalg.norm(pg[tan[start]], axis=1), 1e-300)[:, None]
+            # a node leaving ξ = 0 moves along its held direction only: the
+            # coupled Newton step may point it elsewhere (in 3D), and a slip
+            # off the direction of −h meets a friction force of size κ_a in
+            # the wrong direction; the next step turns it back to 0, and
+            # with a flat energy the two iterates alternate for ever
+            along = np.maximum(np.sum(d[tan[start]] * ref[start], axis=1), 0.0)
+            d[tan[start]] = along[:, None] * ref[start]
 
         def project(trial):
             trial = np.minimum(trial, upper)
