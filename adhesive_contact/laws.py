@@ -12,7 +12,9 @@ r = u_ν (positive towards the foundation):
 Friction potentials are radial, j_τ(β, ξ) = φ(β, |ξ|) with φ(β, 0) = 0,
 and give φ, φ' = ∂_s φ, φ'' and ``kink(beta)`` = φ'(β, 0+) ≥ 0: the Clarke
 subdifferential of j_τ(β, ·) at ξ = 0 is the ball of that radius (the
-friction bound), and ∇j_τ = φ'(|ξ|) ξ/|ξ| elsewhere. ``relaxation`` is m_τ.
+friction bound), and ∇j_τ = φ'(|ξ|) ξ/|ξ| elsewhere. The class attribute
+``has_kink`` says whether φ'(β, 0+) can be > 0 (a law with a kink needs the
+nodal rule on Γ_C); ``relaxation`` is m_τ.
 
 The bonding law gives F(r, ξ, β) of (1.7) and its Lipschitz constant L_F.
 
@@ -134,6 +136,7 @@ class Tresca:
     """j_τ = μ |ξ|: a constant friction bound μ; convex, m_τ = 0."""
 
     mu: float
+    has_kink = True
     relaxation = 0.0
 
     def kink(self, beta):
@@ -159,6 +162,7 @@ class SlipWeakening:
     a: float
     b: float
     alpha: float
+    has_kink = True
 
     @property
     def relaxation(self):
@@ -194,6 +198,7 @@ class PowerLaw:
 
     mu: float
     q: float
+    has_kink = False
     relaxation = 0.0
 
     @staticmethod
@@ -227,6 +232,7 @@ class AdhesiveSpring:
 
     gamma: float
     L: float
+    has_kink = False
 
     @property
     def relaxation(self):
@@ -263,7 +269,7 @@ class FrictionSum:
 
     @property
     def has_kink(self):
-        return any(isinstance(law, (Tresca, SlipWeakening)) for law in self.laws)
+        return any(law.has_kink for law in self.laws)
 
     def kink(self, beta):
         return sum(law.kink(beta) for law in self.laws)

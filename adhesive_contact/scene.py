@@ -381,10 +381,12 @@ def _read_contact(table, dim, coords):
         bonding_table.finish()
     resolved["bonding"] = {"law": bonding.law, **bonding.params}
     table.finish()
-    kinked = [f.law for f in friction if f.law in ("tresca", "nonmonotone")]
+    kinked = [f.law for f in friction if FRICTION_LAWS[f.law][0].has_kink]
     if quadrature == "gauss" and kinked:
+        smooth = ", ".join(name for name, (cls, _) in FRICTION_LAWS.items()
+                           if cls is not None and not cls.has_kink)
         raise SceneError(table.key("quadrature"), f"'gauss' takes smooth friction laws only "
-                         f"(power, adhesive_spring); {kinked[0]!r} needs 'nodal'")
+                         f"({smooth}); {kinked[0]!r} needs 'nodal'")
     return ContactSpec(gap, quadrature, order, normal, tuple(friction), bonding, beta0), resolved
 
 

@@ -387,6 +387,20 @@ def test_friction_sum_kink_and_constants_are_sums():
 
 
 @pytest.mark.parametrize("law", FRICTION[:5], ids=repr)
+def test_has_kink_says_whether_the_friction_bound_is_positive(law):
+    beta = np.linspace(0.0, 1.0, 5)
+    assert type(law).has_kink == bool(np.all(law.kink(beta[1:]) > 0))
+    assert np.all(law.kink(beta) >= 0)
+    assert type(law) in {cls for cls, _ in FRICTION_LAWS.values()}
+
+
+def test_every_registered_friction_law_says_whether_it_has_a_kink():
+    classes = {cls for cls, _ in FRICTION_LAWS.values() if cls is not None}
+    assert classes == {type(law) for law in FRICTION[:5]}   # each one tested above
+    assert all(isinstance(cls.has_kink, bool) for cls in classes)
+
+
+@pytest.mark.parametrize("law", FRICTION[:5], ids=repr)
 def test_kink_and_dphi_keep_floats_for_integer_input(law):
     # β = 1 given as a Python or numpy integer must not truncate the bound
     # (np.full_like copies the dtype of its template)

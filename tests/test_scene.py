@@ -113,6 +113,20 @@ def test_bad_input_names_the_key(path, value, message):
     assert "\n" not in text
 
 
+def test_gauss_quadrature_takes_only_the_laws_without_a_kink():
+    data = base()
+    data["contact"]["quadrature"] = "gauss"
+    data["contact"]["friction"] = [{"law": "power", "mu": 1.0, "q": 0.5},
+                                   {"law": "tresca", "mu": 1.0}]
+    with pytest.raises(SceneError) as err:
+        scene_from_dict(data)
+    assert str(err.value) == ("contact.quadrature: 'gauss' takes smooth friction laws only "
+                              "(power, adhesive_spring); 'tresca' needs 'nodal'")
+    data["contact"]["friction"] = [{"law": "power", "mu": 1.0, "q": 0.5},
+                                   {"law": "adhesive_spring", "gamma": 1.0, "L": 0.1}]
+    assert scene_from_dict(data).contact.quadrature == "gauss"
+
+
 def test_invalid_toml_is_a_scene_error():
     with pytest.raises(SceneError, match="not valid TOML"):
         parse_scene("dim = = 2")
