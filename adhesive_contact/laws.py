@@ -14,7 +14,9 @@ and give φ, φ' = ∂_s φ, φ'' and ``kink(beta)`` = φ'(β, 0+) ≥ 0: the Cl
 subdifferential of j_τ(β, ·) at ξ = 0 is the ball of that radius (the
 friction bound), and ∇j_τ = φ'(|ξ|) ξ/|ξ| elsewhere. The class attribute
 ``has_kink`` says whether φ'(β, 0+) can be > 0 (a law with a kink needs the
-nodal rule on Γ_C); ``relaxation`` is m_τ.
+nodal rule on Γ_C); ``m_tau`` is m_τ, the constant of the relaxed
+monotonicity (∇j_τ(β₁, ξ₁) − ∇j_τ(β₂, ξ₂))·(ξ₁ − ξ₂) ≥ −m_τ (|β₁ − β₂| +
+|ξ₁ − ξ₂|) |ξ₁ − ξ₂|.
 
 The bonding law gives F(r, ξ, β) of (1.7) and its Lipschitz constant L_F.
 
@@ -137,7 +139,7 @@ class Tresca:
 
     mu: float
     has_kink = True
-    relaxation = 0.0
+    m_tau = 0.0
 
     def kink(self, beta):
         return np.full(np.shape(beta), float(self.mu))
@@ -165,7 +167,7 @@ class SlipWeakening:
     has_kink = True
 
     @property
-    def relaxation(self):
+    def m_tau(self):
         return self.alpha * (self.a - self.b)
 
     @property
@@ -199,7 +201,7 @@ class PowerLaw:
     mu: float
     q: float
     has_kink = False
-    relaxation = 0.0
+    m_tau = 0.0
 
     @staticmethod
     def check(params):
@@ -235,7 +237,7 @@ class AdhesiveSpring:
     has_kink = False
 
     @property
-    def relaxation(self):
+    def m_tau(self):
         return 2.0 * self.gamma * self.L
 
     def kink(self, beta):
@@ -259,8 +261,9 @@ class FrictionSum:
     laws: tuple
 
     @property
-    def relaxation(self):
-        return sum(law.relaxation for law in self.laws)
+    def m_tau(self):
+        """m_τ of the sum: the sum of the m_τ of its laws."""
+        return sum(law.m_tau for law in self.laws)
 
     @property
     def nonconvexity(self):

@@ -66,7 +66,7 @@ def smallness(scene, normal_law, friction):
     lam, mu = scene.material.lam, scene.material.mu
     m_A = min(2.0 * mu, scene.dim * lam + 2.0 * mu)
     m_nu = float(normal_law.lipschitz)
-    m_tau = 0.0 if friction is None else float(friction.relaxation)
+    m_tau = 0.0 if friction is None else float(friction.m_tau)
     ce2 = trace_constant_squared(scene) if scene.contact_sides else 0.0
     rhs = (m_tau + m_nu) * ce2
     m_c = 0.0 if friction is None else float(friction.nonconvexity)

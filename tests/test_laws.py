@@ -383,7 +383,7 @@ def test_friction_sum_kink_and_constants_are_sums():
     assert np.allclose(both.kink(beta), 0.3 + 0.8, rtol=4 * EPS, atol=0)
     assert both.has_kink and FrictionSum((sw,)).has_kink
     assert not FrictionSum((p, sp)).has_kink
-    assert FrictionSum((t, sw, p, sp)).relaxation == pytest.approx(4.0 * 0.5 + 2 * 2.0 * 0.8)
+    assert FrictionSum((t, sw, p, sp)).m_tau == pytest.approx(4.0 * 0.5 + 2 * 2.0 * 0.8)
 
 
 @pytest.mark.parametrize("law", FRICTION[:5], ids=repr)
@@ -464,7 +464,7 @@ def gradient_1d(law, xi):
 
 def test_slip_weakening_is_relaxed_monotone_with_sharp_constant():
     law = SlipWeakening(a=0.8, b=0.3, alpha=4.0)
-    m = law.relaxation
+    m = law.m_tau
     assert m == pytest.approx(4.0 * 0.5)
     rng = np.random.default_rng(7)
     x1, x2 = rng.uniform(-2, 2, (2, 20000))
@@ -491,7 +491,7 @@ def test_adhesive_spring_is_relaxed_monotone_in_beta_and_xi():
     dxi = np.linalg.norm(x1 - x2, axis=-1)
     g1, g2 = fs.gradient(b1, x1), fs.gradient(b2, x2)
     lhs = np.sum((g1 - g2) * (x1 - x2), axis=-1)
-    rhs = -law.relaxation * (np.abs(b1 - b2) + dxi) * dxi
+    rhs = -law.m_tau * (np.abs(b1 - b2) + dxi) * dxi
     rounding = 8 * EPS * (np.linalg.norm(g1, axis=-1) + np.linalg.norm(g2, axis=-1)) * dxi
     assert np.all(lhs >= rhs * (1 + SLACK) - rounding)
 
