@@ -7,7 +7,8 @@ r = u_ν (positive towards the foundation):
 - ``value(beta, r)``      p_ν(β, r), the normal reaction density,
 - ``derivative(beta, r)`` ∂_r p_ν (one element of the generalised
   derivative at a kink),
-- ``lipschitz``           m_ν of MODEL.md §2.
+- ``lipschitz``           m_ν, the (sharp) constant of
+  |p_ν(β₁, r₁) − p_ν(β₂, r₂)| ≤ m_ν (|β₁ − β₂| + |r₁ − r₂|), β ∈ [0, 1].
 
 Friction potentials are radial, j_τ(β, ξ) = φ(β, |ξ|) with φ(β, 0) = 0,
 and give φ, φ' = ∂_s φ, φ'' and ``kink(beta)`` = φ'(β, 0+) ≥ 0: the Clarke
@@ -54,7 +55,6 @@ class NoNormalLaw:
 
     active = False
     lipschitz = 0.0
-    uses_beta = False
 
     def potential(self, beta, r):
         return np.zeros_like(r)
@@ -72,7 +72,6 @@ class NormalCompliance:
 
     c: float
     active = True
-    uses_beta = False
 
     @property
     def lipschitz(self):
@@ -100,16 +99,15 @@ class AdhesiveCompliance:
 
     m_ν = max(c, γ, 2 γ L): the slopes in r (c, or γβ² ≤ γ) and in β
     (2 γ β R_ν ≤ 2 γ L) never act together, so this is the sharp constant
-    for |Δp| ≤ m_ν (|Δβ| + |Δr|), β ∈ [0, 1]. MODEL.md §6 quotes the valid
-    but looser max(c + γ, 2 γ L); the sharper one keeps the smallness
-    estimate of :mod:`adhesive_contact.smallness` less conservative.
+    for |Δp| ≤ m_ν (|Δβ| + |Δr|), β ∈ [0, 1]. Being below the plain sum of
+    the slopes, max(c + γ, 2 γ L), it keeps the smallness estimate of
+    :mod:`adhesive_contact.smallness` less conservative.
     """
 
     c: float
     gamma: float
     L: float
     active = True
-    uses_beta = True
 
     @property
     def lipschitz(self):

@@ -215,8 +215,8 @@ def lipschitz_ratios(law, seed):
 
 @pytest.mark.parametrize("params", ADHESIVE_REGIMES, ids=str)
 def test_adhesive_compliance_is_lipschitz_with_m_nu(params):
-    # H(p_ν)(b) with the law's m_ν, which must not exceed the constant
-    # max(c + γ, 2γL) stated in MODEL.md §6 (itself a valid bound)
+    # H(p_ν)(b) with the law's m_ν = max(c, γ, 2γL), which cannot exceed the
+    # plain sum of the slopes max(c + γ, 2γL) (also a valid bound)
     law = AdhesiveCompliance(**params)
     assert law.lipschitz <= max(law.c + law.gamma, 2 * law.gamma * law.L)
     ratio, rounding = lipschitz_ratios(law, 4)
