@@ -178,3 +178,24 @@ def test_no_builtin_eval_exec_compile_in_module():
             assert node.func.id not in {"eval", "exec", "compile",
                                         "__import__"}, node.func.id
     assert "builtins" not in inspect.getsource(expressions)
+
+
+def _call(name):
+    """A call of ``name`` with its arity, arguments in the domain of every function."""
+    return {1: f"{name}(0.3 + 0.4*x)", 2: f"{name}(0.3 + 0.4*x, 0.5 - 0.2*x)",
+            3: f"{name}(x < 0.5, 0.3 + x, 0.2*x)" if name == "where"
+            else f"{name}(x, 0.3, 0.6)"}[expressions.FUNCTIONS[name].arity]
+
+
+@pytest.mark.parametrize("name", list(expressions.FUNCTIONS))
+def test_numpy_and_sympy_forms_of_each_function_agree(name):
+    # the one function table gives both forms; manufactured solutions
+    # differentiate the sympy one, the time loop evaluates the NumPy one
+    import sympy
+
+    from adhesive_contact.manufactured import to_sympy
+    x = np.linspace(0.05, 0.95, 13)
+    expr = compile_expression(_call(name))
+    symbol = sympy.Symbol("x")
+    exact = sympy.lambdify(symbol, to_sympy(expr, {"x": symbol}), modules="numpy")
+    np.testing.assert_allclose(expr(x), exact(x) + 0 * x, rtol=1e-14, atol=0)
