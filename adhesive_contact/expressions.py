@@ -193,16 +193,25 @@ class Expression:
     Attributes
     ----------
     source : str
-        The original text.
+        The original text (``str(number)`` for a number).
+    number : int, float or None
+        The number the expression was compiled from, as given; None when it
+        was compiled from text.
     uses : frozenset
         Which of ``'x', 'y', 'z', 't'`` the expression references.
 
     """
 
-    def __init__(self, source, tree, uses):
+    def __init__(self, source, tree, uses, number=None):
         self.source = source
+        self.number = number
         self.uses = frozenset(uses)
         self._tree = tree
+
+    @property
+    def given(self):
+        """What the expression was compiled from: the number, or the text."""
+        return self.source if self.number is None else self.number
 
     @property
     def is_constant(self):
@@ -273,7 +282,8 @@ def compile_expression(source):
         return source
     if isinstance(source, numbers.Real) and not isinstance(source,
                                                            (bool, np.bool_)):
-        return Expression(repr(source), ast.Constant(float(source)), ())
+        return Expression(str(source), ast.Constant(float(source)), (),
+                          number=source)
     if not isinstance(source, str):
         raise ExpressionError("expression must be a string or a number, "
                               "not {}".format(type(source).__name__))

@@ -69,6 +69,15 @@ def test_number_input():
         compile_expression(None)
 
 
+def test_an_expression_keeps_what_it_was_given():
+    text = compile_expression(" 2*x ")
+    assert (text.source, text.number, text.given) == (" 2*x ", None, " 2*x ")
+    for number, source in ((0.02, "0.02"), (-40, "-40"), (np.float64(1.5), "1.5")):
+        expr = compile_expression(number)
+        assert expr.source == source and expr.given is number
+        assert compile_expression(expr.source)(X)[0] == number   # the text reads back
+
+
 def test_uses_and_flags():
     expr = compile_expression("0.02 + 0.01*sin(pi*x) * t")
     assert isinstance(expr, Expression)
