@@ -1,6 +1,7 @@
 """The scene reader: resolved values, and one clear error per bad input."""
 
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +49,56 @@ def test_defaults_and_lame_pair():
     assert scene.k == 0.25
     assert scene.memory is None
     assert scene.resolved["time"] == {"T": 1.0, "steps": 4, "k": 0.25}
+
+
+def test_resolved_record_lists_every_table_with_its_defaults():
+    assert scene_from_dict(base()).resolved == {
+        "title": "untitled", "dim": 2,
+        "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [4, 2],
+                 "pattern": "diagonal", "refine": 0},
+        "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
+        "material": {"E": 1000.0, "nu": 0.25, "lam": 400.0,
+                     "mu": 400.0},
+        "memory": None,
+        "loads": {"body": ["0", "0"], "traction": {"top": ["0", "-t"]}},
+        "contact": {"gap": 0.01, "quadrature": "nodal", "order": 4,
+                    "normal": {"law": "compliance", "c": 100.0}, "friction": [],
+                    "bonding": {"law": "none"}},
+        "time": {"T": 1.0, "steps": 4, "k": 0.25},
+        "solver": {"method": "newton", "tol": 1e-10, "max_iter": 50},
+        "output": {"probes": []},
+        "exact": None,
+    }
+
+
+def test_resolved_record_keeps_what_the_scene_gave():
+    # numbers stay numbers (gap, beta0) or their text (loads); the material
+    # pair given is kept; a bonding table records the integrator
+    data = base()
+    data["material"] = {"lam": 3.0, "mu": 2.0}
+    data["memory"] = {"kernel": "function", "r": 2, "E": 1.0, "nu": 0.2}
+    data["loads"] = {"body": [0, -1.5]}
+    data["contact"]["gap"] = "0.01 + x"
+    data["contact"]["bonding"] = {"law": "none", "beta0": 1}
+    resolved = scene_from_dict(data).resolved
+    assert resolved["material"] == {"lam": 3.0, "mu": 2.0}
+    assert resolved["memory"] == {"kernel": "function", "r": "2", "E": 1.0, "nu": 0.2}
+    assert resolved["loads"] == {"body": ["0", "-1.5"], "traction": {}}
+    contact = resolved["contact"]
+    assert contact["gap"] == "0.01 + x"
+    assert contact["beta0"] == 1 and type(contact["beta0"]) is int
+    assert contact["integrator"] == "explicit" and contact["bonding"] == {"law": "none"}
+
+
+def test_resolved_record_follows_a_replaced_discretisation():
+    # the record is derived from the dataclasses: nothing to patch
+    scene = scene_from_dict(base())
+    finer = replace(scene, mesh=replace(scene.mesh, refine=2), steps=16)
+    assert finer.resolved["mesh"]["refine"] == 2
+    assert finer.resolved["time"] == {"T": 1.0, "steps": 16, "k": 0.0625}
+    assert scene.resolved["mesh"]["refine"] == 0
+    other = {**finer.resolved, "mesh": scene.resolved["mesh"], "time": scene.resolved["time"]}
+    assert other == scene.resolved
 
 
 def test_lame_input_is_taken_as_is():
