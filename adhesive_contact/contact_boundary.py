@@ -121,15 +121,6 @@ class ContactBoundary:
     node_weights: np.ndarray
     point_node: np.ndarray
 
-    @property
-    def n_unknowns(self):
-        return self.nodes.size * self.dim
-
-    @property
-    def normal_unknowns(self):
-        """Indices into z of the normal components z_{a,0} = u_ν(x_a)."""
-        return np.arange(self.nodes.size) * self.dim
-
     def rotation(self, ndofs):
         """Sparse R (ndofs × ndofs): u = R ũ with ũ the nodal-frame components
         at the contact nodes and the Cartesian ones elsewhere (R orthogonal)."""

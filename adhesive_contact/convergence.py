@@ -40,16 +40,10 @@ PARAMS = ("h", "k", "hk")
 
 
 def with_discretisation(scene, refine=None, steps=None):
-    """The scene with another mesh refinement and/or number of steps (its
-    resolved record updated to match)."""
+    """The scene with another mesh refinement and/or number of steps."""
     refine = scene.mesh.refine if refine is None else refine
     steps = scene.steps if steps is None else steps
-    resolved = copy.deepcopy(scene.resolved)
-    if resolved:
-        resolved["mesh"]["refine"] = refine
-        resolved["time"].update(steps=steps, k=scene.T / steps)
-    return replace(scene, mesh=replace(scene.mesh, refine=refine), steps=steps,
-                   resolved=resolved)
+    return replace(scene, mesh=replace(scene.mesh, refine=refine), steps=steps)
 
 
 def level_scene(scene, param, level):

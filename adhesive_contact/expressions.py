@@ -13,6 +13,7 @@ The validated tree is then evaluated by walking it with NumPy arrays.
 """
 import ast
 import numbers
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -22,18 +23,42 @@ MAX_LENGTH = 2000
 MAX_DEPTH = 100
 VARIABLES = ('x', 'y', 'z', 't')
 CONSTANTS = {'pi': np.pi, 'e': np.e}
+
+
+class Function(NamedTuple):
+    """A function an expression may call: its NumPy form, its number of
+    arguments and its sympy form (``sympy(module)`` returns a callable of
+    sympy expressions; sympy is imported only for manufactured solutions)."""
+
+    numpy: Callable
+    arity: int
+    sympy: Callable
+
+
+def _unary(numpy, sympy_name):
+    return Function(numpy, 1, lambda sp: getattr(sp, sympy_name))
+
+
 FUNCTIONS = {
-    'sin': np.sin, 'cos': np.cos, 'tan': np.tan, 'arcsin': np.arcsin,
-    'arccos': np.arccos, 'arctan': np.arctan, 'arctan2': np.arctan2,
-    'sinh': np.sinh, 'cosh': np.cosh, 'tanh': np.tanh, 'exp': np.exp,
-    'log': np.log, 'log10': np.log10, 'sqrt': np.sqrt, 'abs': np.abs,
-    'minimum': np.minimum, 'maximum': np.maximum, 'where': np.where,
-    'sign': np.sign, 'floor': np.floor, 'ceil': np.ceil,
-    'heaviside': np.heaviside, 'hypot': np.hypot, 'clip': np.clip,
+    'sin': _unary(np.sin, 'sin'), 'cos': _unary(np.cos, 'cos'),
+    'tan': _unary(np.tan, 'tan'), 'arcsin': _unary(np.arcsin, 'asin'),
+    'arccos': _unary(np.arccos, 'acos'), 'arctan': _unary(np.arctan, 'atan'),
+    'arctan2': Function(np.arctan2, 2, lambda sp: sp.atan2),
+    'sinh': _unary(np.sinh, 'sinh'), 'cosh': _unary(np.cosh, 'cosh'),
+    'tanh': _unary(np.tanh, 'tanh'), 'exp': _unary(np.exp, 'exp'),
+    'log': _unary(np.log, 'log'),
+    'log10': Function(np.log10, 1, lambda sp: lambda a: sp.log(a, 10)),
+    'sqrt': _unary(np.sqrt, 'sqrt'), 'abs': _unary(np.abs, 'Abs'),
+    'minimum': Function(np.minimum, 2, lambda sp: sp.Min),
+    'maximum': Function(np.maximum, 2, lambda sp: sp.Max),
+    'where': Function(np.where, 3,
+                      lambda sp: lambda c, a, b: sp.Piecewise((a, c), (b, True))),
+    'sign': _unary(np.sign, 'sign'), 'floor': _unary(np.floor, 'floor'),
+    'ceil': _unary(np.ceil, 'ceiling'),
+    'heaviside': Function(np.heaviside, 2, lambda sp: sp.Heaviside),
+    'hypot': Function(np.hypot, 2, lambda sp: lambda a, b: sp.sqrt(a * a + b * b)),
+    'clip': Function(np.clip, 3, lambda sp: lambda a, lo, hi: sp.Min(sp.Max(a, lo), hi)),
 }
-ARITY = {name: 1 for name in FUNCTIONS}
-ARITY.update(where=3, clip=3, minimum=2, maximum=2, arctan2=2, hypot=2,
-             heaviside=2)
 BINOPS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply,
           ast.Div: np.true_divide, ast.Pow: np.power}
 UNARYOPS = {ast.UAdd: np.positive, ast.USub: np.negative}
@@ -126,9 +151,9 @@ def _check(node, uses, depth=0):
         if node.keywords:
             raise ExpressionError("keyword arguments are not allowed "
                                   "(in call to '{}')".format(name))
-        if len(node.args) != ARITY[name]:
+        if len(node.args) != FUNCTIONS[name].arity:
             raise ExpressionError("function '{}' takes {} argument(s), got {}"
-                                  .format(name, ARITY[name], len(node.args)))
+                                  .format(name, FUNCTIONS[name].arity, len(node.args)))
         children = node.args
     else:
         raise ExpressionError("{} is not allowed in expressions"
@@ -159,7 +184,7 @@ def _eval(node, env):
             out = np.logical_and(out, COMPAREOPS[type(op)](left, right))
             left = right
         return out
-    return FUNCTIONS[node.func.id](*(_eval(arg, env) for arg in node.args))
+    return FUNCTIONS[node.func.id].numpy(*(_eval(arg, env) for arg in node.args))
 
 
 class Expression:
@@ -168,16 +193,25 @@ class Expression:
     Attributes
     ----------
     source : str
-        The original text.
+        The original text (``str(number)`` for a number).
+    number : int, float or None
+        The number the expression was compiled from, as given; None when it
+        was compiled from text.
     uses : frozenset
         Which of ``'x', 'y', 'z', 't'`` the expression references.
 
     """
 
-    def __init__(self, source, tree, uses):
+    def __init__(self, source, tree, uses, number=None):
         self.source = source
+        self.number = number
         self.uses = frozenset(uses)
         self._tree = tree
+
+    @property
+    def given(self):
+        """What the expression was compiled from: the number, or the text."""
+        return self.source if self.number is None else self.number
 
     @property
     def is_constant(self):
@@ -248,7 +282,8 @@ def compile_expression(source):
         return source
     if isinstance(source, numbers.Real) and not isinstance(source,
                                                            (bool, np.bool_)):
-        return Expression(repr(source), ast.Constant(float(source)), ())
+        return Expression(str(source), ast.Constant(float(source)), (),
+                          number=source)
     if not isinstance(source, str):
         raise ExpressionError("expression must be a string or a number, "
                               "not {}".format(type(source).__name__))

@@ -7,12 +7,17 @@ r = u_ν (positive towards the foundation):
 - ``value(beta, r)``      p_ν(β, r), the normal reaction density,
 - ``derivative(beta, r)`` ∂_r p_ν (one element of the generalised
   derivative at a kink),
-- ``lipschitz``           m_ν of MODEL.md §2.
+- ``lipschitz``           m_ν, the (sharp) constant of
+  |p_ν(β₁, r₁) − p_ν(β₂, r₂)| ≤ m_ν (|β₁ − β₂| + |r₁ − r₂|), β ∈ [0, 1].
 
 Friction potentials are radial, j_τ(β, ξ) = φ(β, |ξ|) with φ(β, 0) = 0,
 and give φ, φ' = ∂_s φ, φ'' and ``kink(beta)`` = φ'(β, 0+) ≥ 0: the Clarke
 subdifferential of j_τ(β, ·) at ξ = 0 is the ball of that radius (the
-friction bound), and ∇j_τ = φ'(|ξ|) ξ/|ξ| elsewhere. ``relaxation`` is m_τ.
+friction bound), and ∇j_τ = φ'(|ξ|) ξ/|ξ| elsewhere. The class attribute
+``has_kink`` says whether φ'(β, 0+) can be > 0 (a law with a kink needs the
+nodal rule on Γ_C); ``m_tau`` is m_τ, the constant of the relaxed
+monotonicity (∇j_τ(β₁, ξ₁) − ∇j_τ(β₂, ξ₂))·(ξ₁ − ξ₂) ≥ −m_τ (|β₁ − β₂| +
+|ξ₁ − ξ₂|) |ξ₁ − ξ₂|.
 
 The bonding law gives F(r, ξ, β) of (1.7) and its Lipschitz constant L_F.
 
@@ -50,7 +55,6 @@ class NoNormalLaw:
 
     active = False
     lipschitz = 0.0
-    uses_beta = False
 
     def potential(self, beta, r):
         return np.zeros_like(r)
@@ -68,7 +72,6 @@ class NormalCompliance:
 
     c: float
     active = True
-    uses_beta = False
 
     @property
     def lipschitz(self):
@@ -96,16 +99,15 @@ class AdhesiveCompliance:
 
     m_ν = max(c, γ, 2 γ L): the slopes in r (c, or γβ² ≤ γ) and in β
     (2 γ β R_ν ≤ 2 γ L) never act together, so this is the sharp constant
-    for |Δp| ≤ m_ν (|Δβ| + |Δr|), β ∈ [0, 1]. MODEL.md §6 quotes the valid
-    but looser max(c + γ, 2 γ L); the sharper one keeps the smallness
-    estimate of :mod:`adhesive_contact.smallness` less conservative.
+    for |Δp| ≤ m_ν (|Δβ| + |Δr|), β ∈ [0, 1]. Being below the plain sum of
+    the slopes, max(c + γ, 2 γ L), it keeps the smallness estimate of
+    :mod:`adhesive_contact.smallness` less conservative.
     """
 
     c: float
     gamma: float
     L: float
     active = True
-    uses_beta = True
 
     @property
     def lipschitz(self):
@@ -134,7 +136,8 @@ class Tresca:
     """j_τ = μ |ξ|: a constant friction bound μ; convex, m_τ = 0."""
 
     mu: float
-    relaxation = 0.0
+    has_kink = True
+    m_tau = 0.0
 
     def kink(self, beta):
         return np.full(np.shape(beta), float(self.mu))
@@ -159,9 +162,10 @@ class SlipWeakening:
     a: float
     b: float
     alpha: float
+    has_kink = True
 
     @property
-    def relaxation(self):
+    def m_tau(self):
         return self.alpha * (self.a - self.b)
 
     @property
@@ -194,7 +198,8 @@ class PowerLaw:
 
     mu: float
     q: float
-    relaxation = 0.0
+    has_kink = False
+    m_tau = 0.0
 
     @staticmethod
     def check(params):
@@ -227,9 +232,10 @@ class AdhesiveSpring:
 
     gamma: float
     L: float
+    has_kink = False
 
     @property
-    def relaxation(self):
+    def m_tau(self):
         return 2.0 * self.gamma * self.L
 
     def kink(self, beta):
@@ -253,8 +259,9 @@ class FrictionSum:
     laws: tuple
 
     @property
-    def relaxation(self):
-        return sum(law.relaxation for law in self.laws)
+    def m_tau(self):
+        """m_τ of the sum: the sum of the m_τ of its laws."""
+        return sum(law.m_tau for law in self.laws)
 
     @property
     def nonconvexity(self):
@@ -263,7 +270,7 @@ class FrictionSum:
 
     @property
     def has_kink(self):
-        return any(isinstance(law, (Tresca, SlipWeakening)) for law in self.laws)
+        return any(law.has_kink for law in self.laws)
 
     def kink(self, beta):
         return sum(law.kink(beta) for law in self.laws)

@@ -25,6 +25,8 @@ from functools import partial
 
 import numpy as np
 
+from .expressions import FUNCTIONS
+
 _GAUSS_POINTS = 16   # Gauss–Legendre points in s for the memory integral (exact to
                      # round-off for the smooth integrands of manufactured data)
 
@@ -37,16 +39,6 @@ def _sympy():
 def to_sympy(expression, symbols):
     """The sympy form of a restricted :class:`~adhesive_contact.expressions.Expression`."""
     sp = _sympy()
-    funcs = {
-        "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "arcsin": sp.asin, "arccos": sp.acos,
-        "arctan": sp.atan, "arctan2": sp.atan2, "sinh": sp.sinh, "cosh": sp.cosh,
-        "tanh": sp.tanh, "exp": sp.exp, "log": sp.log, "log10": lambda a: sp.log(a, 10),
-        "sqrt": sp.sqrt, "abs": sp.Abs, "minimum": sp.Min, "maximum": sp.Max,
-        "where": lambda c, a, b: sp.Piecewise((a, c), (b, True)), "sign": sp.sign,
-        "floor": sp.floor, "ceil": sp.ceiling, "heaviside": sp.Heaviside,
-        "hypot": lambda a, b: sp.sqrt(a * a + b * b),
-        "clip": lambda a, lo, hi: sp.Min(sp.Max(a, lo), hi),
-    }
     binops = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
               ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
               ast.Pow: lambda a, b: a ** b}
@@ -72,7 +64,7 @@ def to_sympy(expression, symbols):
                 out = sp.And(out, compare[type(op)](left, right))
                 left = right
             return out
-        return funcs[node.func.id](*(walk(a) for a in node.args))
+        return FUNCTIONS[node.func.id].sympy(sp)(*(walk(a) for a in node.args))
 
     return walk(expression._tree)
 

@@ -6,6 +6,14 @@ missing, unknown or wrongly typed key, or a value outside its range, raises
 :class:`SceneError` whose message is one line that names the key and says
 what is allowed. Nothing is computed here; geometry-dependent checks (a
 probe outside the mesh, a negative gap) are made when the problem is built.
+
+The :class:`Scene` dataclasses are the one stored form of a scene; its
+``resolved`` record (every default filled in, written to summary.json and
+to the identity of a convergence study) is derived from them on demand, so
+``dataclasses.replace`` gives a consistent scene. Absent optional tables:
+``[memory]`` and ``[exact]`` add a part to the problem and are None when
+absent; ``[loads]``, ``[contact]``, ``[solver]`` and ``[output]`` only
+set values that have defaults and read as those defaults when absent.
 """
 
 import math
@@ -30,6 +38,8 @@ SIDES = {2: ("left", "right", "bottom", "top"),
 
 @dataclass(frozen=True)
 class MeshSpec:
+    """The ``[mesh]`` table: a structured mesh of ``domain`` refined ``refine`` times."""
+
     domain: str
     size: tuple
     cells: tuple
@@ -39,10 +49,16 @@ class MeshSpec:
 
 @dataclass(frozen=True)
 class Isotropic:
-    """An isotropic tensor C ε = λ tr(ε) I + 2 μ ε given by its Lamé pair."""
+    """An isotropic tensor C ε = λ tr(ε) I + 2 μ ε given by its Lamé pair.
+
+    ``E`` and ``nu`` are the Young pair the scene gave, from which λ and μ
+    were computed; both None when the scene gave (λ, μ) itself.
+    """
 
     lam: float
     mu: float
+    E: float = None
+    nu: float = None
 
 
 @dataclass(frozen=True)
@@ -65,19 +81,35 @@ class MemorySpec:
 
 @dataclass(frozen=True)
 class LawSpec:
+    """A law of the registry in :mod:`adhesive_contact.laws` and its parameters
+    (law ``"none"`` for no law)."""
+
     law: str
     params: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class ContactSpec:
+    """The ``[contact]`` table; ``ContactSpec()`` when the scene has none.
+
+    ``gap`` None: no wall; ``beta0`` None: β_0 = 1; no law is law ``"none"``
+    (``friction`` lists the laws whose potentials sum, none of them
+    ``"none"``).
+    """
+
     gap: object = None            # Expression, or None for no wall
     quadrature: str = "nodal"
     order: int = 4                # exactness of the Gauss rule on Γ_C
     normal: LawSpec = LawSpec("none")
     friction: tuple = ()          # LawSpecs whose potentials sum
     bonding: LawSpec = LawSpec("none")
-    beta0: object = None          # Expression for β_0
+    beta0: object = None          # Expression for β_0, or None for β_0 = 1
+    integrator: str = "explicit"  # for the bonding ODE
+
+    @property
+    def bonded(self):
+        """Whether the scene sets the bonding at all: a law or β_0."""
+        return self.bonding.law != "none" or self.beta0 is not None
 
 
 @dataclass(frozen=True)
@@ -86,7 +118,7 @@ class ExactSpec:
 
     u: tuple                      # d Expressions in x, y, (z), t
     beta: object = None           # Expression, or None (β* = 1)
-    multiplier: object = None     # Expression λ* > 0 where u*_ν = g
+    multiplier: object = None     # Expression λ* > 0 where u*_ν = g, or None
 
 
 @dataclass(frozen=True)
@@ -98,6 +130,8 @@ class SolverSpec:
 
 @dataclass(frozen=True)
 class Scene:
+    """A validated scene (see the module docstring for absent tables)."""
+
     title: str
     dim: int
     mesh: MeshSpec
@@ -112,8 +146,7 @@ class Scene:
     steps: int
     solver: SolverSpec
     probes: tuple
-    exact: ExactSpec = None
-    resolved: dict = field(default_factory=dict, compare=False, repr=False)
+    exact: ExactSpec = None       # None: no manufactured solution
 
     @property
     def k(self):
@@ -127,6 +160,88 @@ class Scene:
         return bool(self.contact_sides) and (
             c.gap is not None or c.normal.law != "none" or len(c.friction) > 0
             or c.bonding.law != "none")
+
+    @property
+    def resolved(self):
+        """The scene with every default filled in, as a JSON-able dict of its
+        tables (expressions as their text, or as the number given)."""
+        return {
+            "title": self.title, "dim": self.dim,
+            "mesh": {"domain": self.mesh.domain, "size": list(self.mesh.size),
+                     "cells": list(self.mesh.cells), "pattern": self.mesh.pattern,
+                     "refine": self.mesh.refine},
+            "boundary": {"dirichlet": list(self.dirichlet), "contact": list(self.contact_sides)},
+            "material": {**_young(self.material), "lam": self.material.lam,
+                         "mu": self.material.mu},
+            "memory": _memory_record(self.memory),
+            "loads": {"body": _texts(self.body),
+                      "traction": {side: _texts(v) for side, v in self.traction.items()}},
+            "contact": _contact_record(self.contact),
+            "time": {"T": self.T, "steps": self.steps, "k": self.k},
+            "solver": {"method": self.solver.method, "tol": self.solver.tol,
+                       "max_iter": self.solver.max_iter},
+            "output": {"probes": [list(p) for p in self.probes]},
+            "exact": _exact_record(self.exact),
+        }
+
+
+# ---------------------------------------------------------------- the resolved record
+
+
+def _texts(expressions):
+    return [e.source for e in expressions]
+
+
+def _young(tensor):
+    return {} if tensor.E is None else {"E": tensor.E, "nu": tensor.nu}
+
+
+def _pair(tensor):
+    """The pair the scene gave: (E, nu) or (lam, mu)."""
+    return _young(tensor) or {"lam": tensor.lam, "mu": tensor.mu}
+
+
+def _law_record(spec):
+    return {"law": spec.law, **spec.params}
+
+
+def _memory_record(memory):
+    if memory is None:
+        return None
+    if memory.kernel == "prony":
+        return {"kernel": "prony",
+                "terms": [{**_pair(t.tensor), "tau": t.tau} for t in memory.terms]}
+    return {"kernel": "function", "r": memory.function.source, **_pair(memory.tensor)}
+
+
+def _contact_record(contact):
+    """{} for a scene without contact settings."""
+    if contact == ContactSpec():
+        return {}
+    record = {} if contact.gap is None else {"gap": contact.gap.given}
+    record.update(quadrature=contact.quadrature, order=contact.order,
+                  normal=_law_record(contact.normal),
+                  friction=[_law_record(f) for f in contact.friction])
+    if contact.beta0 is not None:
+        record["beta0"] = contact.beta0.given
+    if contact.bonded:
+        record["integrator"] = contact.integrator
+    record["bonding"] = _law_record(contact.bonding)
+    return record
+
+
+def _exact_record(exact):
+    if exact is None:
+        return None
+    record = {"u": _texts(exact.u)}
+    if exact.beta is not None:
+        record["beta"] = exact.beta.source
+    if exact.multiplier is not None:
+        record["multiplier"] = exact.multiplier.source
+    return record
+
+
+# ---------------------------------------------------------------- reading tables
 
 
 class _Table:
@@ -167,7 +282,6 @@ class _Table:
             allowed = ", ".join(sorted(self.used)) or "none"
             raise SceneError(self.key(unknown[0]),
                              f"unknown key; allowed here: {allowed}")
-
 
 
 def _show(value):
@@ -235,14 +349,14 @@ def _isotropic(table, dim):
         if not lam + 2.0 * mu / dim > 0:
             raise SceneError(table.key("lam"),
                              f"must give a positive bulk modulus lam + 2 mu/{dim} > 0")
-        return Isotropic(lam, mu), {"lam": lam, "mu": mu}
+        return Isotropic(lam, mu)
     E = _positive(table.key("E"), table.get("E", "number"))
     nu = table.get("nu", "number")
     if not -1.0 < nu < 0.5:
         raise SceneError(table.key("nu"), f"must lie in (-1, 0.5), got {nu:g}")
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     mu = E / (2.0 * (1.0 + nu))
-    return Isotropic(lam, mu), {"E": E, "nu": nu}
+    return Isotropic(lam, mu, E, nu)
 
 
 def _vector_of_expressions(key, value, dim, variables):
@@ -251,7 +365,8 @@ def _vector_of_expressions(key, value, dim, variables):
     return tuple(_expression(f"{key}[{i}]", v, variables) for i, v in enumerate(value))
 
 
-def _law(table, registry, variables):
+def _law(table, registry):
+    """A LawSpec of ``registry`` (law name -> (class, {parameter: constraint}))."""
     name = _choice(table.key("law"), table.get("law", "str"), tuple(registry))
     params = {}
     for pname, constraint in registry[name][1].items():
@@ -302,90 +417,215 @@ def _read_sides(table, name, dim):
     return tuple(value)
 
 
+def _read_boundary(table, dim):
+    """(Dirichlet sides, contact sides): disjoint, at least one Dirichlet side."""
+    dirichlet = _read_sides(table, "dirichlet", dim)
+    contact_sides = _read_sides(table, "contact", dim)
+    table.finish()
+    if not dirichlet:
+        raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0)")
+    both = set(dirichlet) & set(contact_sides)
+    if both:
+        raise SceneError("boundary.contact", f"side {sorted(both)[0]!r} is also Dirichlet; "
+                         "the parts of the boundary must be disjoint")
+    return dirichlet, contact_sides
+
+
+def _read_material(table, dim):
+    material = _isotropic(table, dim)
+    table.finish()
+    return material
+
+
 def _read_memory(table, dim):
+    """A MemorySpec, or None without a [memory] table."""
+    if table is None:
+        return None
     kernel = _choice(table.key("kernel"), table.get("kernel", "str"), ("prony", "function"))
     if kernel == "prony":
         terms_raw = table.get("terms", "list")
         if not terms_raw:
             raise SceneError(table.key("terms"), "must list at least one term {E, nu, tau}")
-        terms, resolved = [], []
+        terms = []
         for i, raw in enumerate(terms_raw):
             t = _Table(raw, f"{table.key('terms')}[{i}]")
-            tensor, pair = _isotropic(t, dim)
+            tensor = _isotropic(t, dim)
             tau = _positive(t.key("tau"), t.get("tau", "number"))
             t.finish()
             terms.append(PronyTerm(tensor, tau))
-            resolved.append({**pair, "tau": tau})
         table.finish()
-        return MemorySpec("prony", terms=tuple(terms)), {"kernel": "prony", "terms": resolved}
-    source = table.get("r", "expr")
-    function = _expression(table.key("r"), source, ("t",))
-    tensor, pair = _isotropic(table, dim)
+        return MemorySpec("prony", terms=tuple(terms))
+    function = _expression(table.key("r"), table.get("r", "expr"), ("t",))
+    tensor = _isotropic(table, dim)
     table.finish()
-    return (MemorySpec("function", function=function, tensor=tensor),
-            {"kernel": "function", "r": str(source), **pair})
+    return MemorySpec("function", function=function, tensor=tensor)
 
 
-def _read_contact(table, dim, coords):
+def _read_loads(table, dim, dirichlet, contact_sides):
+    """(body, traction): d expressions of f_0 (zero by default) and
+    {side: d expressions of f_N} on Neumann sides (neither Dirichlet nor contact)."""
+    body = tuple(compile_expression("0") for _ in range(dim))
+    traction = {}
     if table is None:
-        return ContactSpec(), {}
-    resolved = {}
+        return body, traction
+    variables = _coordinates(dim) + ("t",)
+    if table.has("body"):
+        body = _vector_of_expressions(table.key("body"), table.get("body", "list"), dim,
+                                      variables)
+    tt = table.table("traction")
+    if tt is not None:
+        for side, raw in tt.data.items():
+            key = tt.key(side)
+            tt.used.add(side)
+            if side not in SIDES[dim]:
+                raise SceneError(key, f"unknown side; sides are {', '.join(SIDES[dim])}")
+            if side in dirichlet or side in contact_sides:
+                raise SceneError(key, "a traction acts on a Neumann side only; "
+                                 f"{side!r} is a {'Dirichlet' if side in dirichlet else 'contact'} side")
+            traction[side] = _vector_of_expressions(key, raw, dim, variables)
+        tt.finish()
+    table.finish()
+    return body, traction
+
+
+def _read_normal(table):
+    """The normal law of ``contact.normal`` (law "none" without the table)."""
+    if table is None:
+        return LawSpec("none")
+    normal = _law(table, NORMAL_LAWS)
+    table.finish()
+    return normal
+
+
+def _read_friction(table):
+    """The friction laws of ``contact.friction``: one table or a list of them."""
+    raw = table.data.get("friction")
+    table.used.add("friction")
+    if raw is None:
+        return ()
+    items = raw if isinstance(raw, list) else [raw]
+    laws = []
+    for i, item in enumerate(items):
+        key = table.key("friction") + (f"[{i}]" if isinstance(raw, list) else "")
+        sub = _Table(item, key)
+        spec = _law(sub, FRICTION_LAWS)
+        sub.finish()
+        if spec.law != "none":
+            laws.append(spec)
+    return tuple(laws)
+
+
+def _read_bonding(table, dim):
+    """(bonding law, β_0 or None, integrator) of ``contact.bonding``."""
+    if table is None:
+        return LawSpec("none"), None, ContactSpec.integrator
+    bonding = _law(table, BONDING_LAWS)
+    beta0 = None
+    if table.has("beta0"):
+        source = table.get("beta0", "expr")
+        beta0 = _expression(table.key("beta0"), source, _coordinates(dim))
+        if beta0.is_constant and not 0.0 <= float(beta0(0.0)) <= 1.0:
+            raise SceneError(table.key("beta0"), f"must lie in [0, 1], got {source}")
+    integrator = _choice(table.key("integrator"),
+                         table.get("integrator", "str", "explicit"), ("explicit",))
+    table.finish()
+    return bonding, beta0, integrator
+
+
+def _read_contact(table, dim, contact_sides):
+    """A ContactSpec; ``ContactSpec()`` without a [contact] table."""
+    if table is None:
+        return ContactSpec()
+    if not contact_sides:
+        raise SceneError("contact", "a [contact] table needs boundary.contact to list its sides")
     gap = None
     if table.has("gap"):
         source = table.get("gap", "expr")
-        gap = _expression(table.key("gap"), source, coords + ("t",))
+        gap = _expression(table.key("gap"), source, _coordinates(dim) + ("t",))
         if gap.is_constant and float(gap(0.0)) < 0:
             raise SceneError(table.key("gap"), f"must be >= 0, got {source}")
-        resolved["gap"] = source
     quadrature = _choice(table.key("quadrature"),
                          table.get("quadrature", "str", "nodal"), ("nodal", "gauss"))
     order = table.get("order", "int", 4, required=False)
     if not 1 <= order <= 10:
         raise SceneError(table.key("order"), f"must be an integer in 1..10, got {order}")
-    resolved.update(quadrature=quadrature, order=order)
-
-    normal_table = table.table("normal")
-    normal = LawSpec("none") if normal_table is None else _law(normal_table, NORMAL_LAWS, coords)
-    if normal_table is not None:
-        normal_table.finish()
-    resolved["normal"] = {"law": normal.law, **normal.params}
-
-    friction = []
-    raw = table.data.get("friction")
-    table.used.add("friction")
-    if raw is not None:
-        items = raw if isinstance(raw, list) else [raw]
-        for i, item in enumerate(items):
-            key = table.key("friction") + (f"[{i}]" if isinstance(raw, list) else "")
-            sub = _Table(item, key)
-            spec = _law(sub, FRICTION_LAWS, coords)
-            sub.finish()
-            if spec.law != "none":
-                friction.append(spec)
-    resolved["friction"] = [{"law": f.law, **f.params} for f in friction]
-
-    bonding_table = table.table("bonding")
-    beta0 = None
-    bonding = LawSpec("none")
-    if bonding_table is not None:
-        bonding = _law(bonding_table, BONDING_LAWS, coords)
-        if bonding_table.has("beta0"):
-            source = bonding_table.get("beta0", "expr")
-            beta0 = _expression(bonding_table.key("beta0"), source, coords)
-            if beta0.is_constant and not 0.0 <= float(beta0(0.0)) <= 1.0:
-                raise SceneError(bonding_table.key("beta0"), f"must lie in [0, 1], got {source}")
-            resolved["beta0"] = source
-        integrator = _choice(bonding_table.key("integrator"),
-                             bonding_table.get("integrator", "str", "explicit"), ("explicit",))
-        resolved["integrator"] = integrator
-        bonding_table.finish()
-    resolved["bonding"] = {"law": bonding.law, **bonding.params}
+    normal = _read_normal(table.table("normal"))
+    friction = _read_friction(table)
+    bonding, beta0, integrator = _read_bonding(table.table("bonding"), dim)
     table.finish()
-    kinked = [f.law for f in friction if f.law in ("tresca", "nonmonotone")]
+    kinked = [f.law for f in friction if FRICTION_LAWS[f.law][0].has_kink]
     if quadrature == "gauss" and kinked:
+        smooth = ", ".join(name for name, (cls, _) in FRICTION_LAWS.items()
+                           if cls is not None and not cls.has_kink)
         raise SceneError(table.key("quadrature"), f"'gauss' takes smooth friction laws only "
-                         f"(power, adhesive_spring); {kinked[0]!r} needs 'nodal'")
-    return ContactSpec(gap, quadrature, order, normal, tuple(friction), bonding, beta0), resolved
+                         f"({smooth}); {kinked[0]!r} needs 'nodal'")
+    return ContactSpec(gap, quadrature, order, normal, friction, bonding, beta0, integrator)
+
+
+def _read_time(table):
+    """(T, steps)."""
+    T = _positive("time.T", table.get("T", "number"))
+    steps = table.get("steps", "int")
+    if steps < 1:
+        raise SceneError("time.steps", f"must be an integer >= 1, got {steps}")
+    table.finish()
+    return T, steps
+
+
+def _read_solver(table):
+    """A SolverSpec; ``SolverSpec()`` without a [solver] table."""
+    if table is None:
+        return SolverSpec()
+    method = _choice("solver.method", table.get("method", "str", "newton"), ("newton",))
+    tol = _positive("solver.tol", table.get("tol", "number", 1e-10))
+    max_iter = table.get("max_iter", "int", 50)
+    if max_iter < 1:
+        raise SceneError("solver.max_iter", f"must be an integer >= 1, got {max_iter}")
+    table.finish()
+    return SolverSpec(method, tol, max_iter)
+
+
+def _read_probes(table, dim):
+    """The probe points of ``output.probes`` (none without an [output] table)."""
+    if table is None:
+        return ()
+    raw = table.get("probes", "list", [], required=False)
+    for i, p in enumerate(raw):
+        if not (isinstance(p, list) and len(p) == dim and all(
+                isinstance(c, (int, float)) and not isinstance(c, bool) for c in p)):
+            raise SceneError(f"output.probes[{i}]", f"must be a point of {dim} numbers, "
+                             f"got {_show(p)}")
+    table.finish()
+    return tuple(tuple(float(c) for c in p) for p in raw)
+
+
+def _read_exact(table, dim, contact, has_loads):
+    """An ExactSpec, or None without an [exact] table. The loads and β_0 of a
+    scene with [exact] come from the exact solution."""
+    if table is None:
+        return None
+    if has_loads:
+        raise SceneError("loads", "a scene with [exact] derives its loads from the exact "
+                         "solution; remove [loads]")
+    variables = _coordinates(dim) + ("t",)
+    u = _vector_of_expressions("exact.u", table.get("u", "list"), dim, variables)
+    beta = multiplier = None
+    if table.has("beta"):
+        beta = _expression("exact.beta", table.get("beta", "expr"), variables)
+        if beta.depends_on_time and contact.bonding.law == "none":
+            raise SceneError("exact.beta", "depends on t, but contact.bonding.law is "
+                             "'none' (β frozen); use a bonding law")
+    if table.has("multiplier"):
+        multiplier = _expression("exact.multiplier", table.get("multiplier", "expr"), variables)
+    table.finish()
+    if contact.beta0 is not None:
+        raise SceneError("contact.bonding.beta0", "a scene with [exact] takes β_0 from "
+                         "exact.beta; remove beta0")
+    return ExactSpec(u, beta, multiplier)
+
+
+def _coordinates(dim):
+    return ("x", "y") if dim == 2 else ("x", "y", "z")
 
 
 def scene_from_dict(data):
@@ -395,132 +635,19 @@ def scene_from_dict(data):
     dim = top.get("dim", "int")
     if dim not in (2, 3):
         raise SceneError("dim", f"must be 2 (plane strain) or 3, got {dim}")
-    coords = ("x", "y") if dim == 2 else ("x", "y", "z")
     mesh = _read_mesh(top.table("mesh", required=True), dim)
-
-    boundary = top.table("boundary", required=True)
-    dirichlet = _read_sides(boundary, "dirichlet", dim)
-    contact_sides = _read_sides(boundary, "contact", dim)
-    boundary.finish()
-    if not dirichlet:
-        raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0)")
-    both = set(dirichlet) & set(contact_sides)
-    if both:
-        raise SceneError("boundary.contact", f"side {sorted(both)[0]!r} is also Dirichlet; "
-                         "the parts of the boundary must be disjoint")
-
-    material_table = top.table("material", required=True)
-    material, material_resolved = _isotropic(material_table, dim)
-    material_table.finish()
-
-    memory_table = top.table("memory")
-    memory, memory_resolved = (None, None) if memory_table is None else \
-        _read_memory(memory_table, dim)
-
-    loads = top.table("loads")
-    body = tuple(compile_expression(0.0) for _ in range(dim))
-    traction = {}
-    loads_resolved = {"body": ["0"] * dim, "traction": {}}
-    if loads is not None:
-        if loads.has("body"):
-            raw = loads.get("body", "list")
-            body = _vector_of_expressions(loads.key("body"), raw, dim, coords + ("t",))
-            loads_resolved["body"] = [str(v) for v in raw]
-        tt = loads.table("traction")
-        if tt is not None:
-            for side, raw in tt.data.items():
-                key = tt.key(side)
-                tt.used.add(side)
-                if side not in SIDES[dim]:
-                    raise SceneError(key, f"unknown side; sides are {', '.join(SIDES[dim])}")
-                if side in dirichlet or side in contact_sides:
-                    raise SceneError(key, "a traction acts on a Neumann side only; "
-                                     f"{side!r} is a {'Dirichlet' if side in dirichlet else 'contact'} side")
-                traction[side] = _vector_of_expressions(key, raw, dim, coords + ("t",))
-                loads_resolved["traction"][side] = [str(v) for v in raw]
-            tt.finish()
-        loads.finish()
-
-    contact_table = top.table("contact")
-    if contact_table is not None and not contact_sides:
-        raise SceneError("contact", "a [contact] table needs boundary.contact to list its sides")
-    contact, contact_resolved = _read_contact(contact_table, dim, coords)
-
-    time = top.table("time", required=True)
-    T = _positive("time.T", time.get("T", "number"))
-    steps = time.get("steps", "int")
-    if steps < 1:
-        raise SceneError("time.steps", f"must be an integer >= 1, got {steps}")
-    time.finish()
-
-    solver_table = top.table("solver")
-    solver = SolverSpec()
-    if solver_table is not None:
-        method = _choice("solver.method", solver_table.get("method", "str", "newton"),
-                         ("newton",))
-        tol = _positive("solver.tol", solver_table.get("tol", "number", 1e-10))
-        max_iter = solver_table.get("max_iter", "int", 50)
-        if max_iter < 1:
-            raise SceneError("solver.max_iter", f"must be an integer >= 1, got {max_iter}")
-        solver = SolverSpec(method, tol, max_iter)
-        solver_table.finish()
-
-    output = top.table("output")
-    probes = ()
-    if output is not None:
-        raw = output.get("probes", "list", [], required=False)
-        for i, p in enumerate(raw):
-            if not (isinstance(p, list) and len(p) == dim and all(
-                    isinstance(c, (int, float)) and not isinstance(c, bool) for c in p)):
-                raise SceneError(f"output.probes[{i}]", f"must be a point of {dim} numbers, "
-                                 f"got {_show(p)}")
-        probes = tuple(tuple(float(c) for c in p) for p in raw)
-        output.finish()
-    exact, exact_resolved = None, None
-    exact_table = top.table("exact")
-    if exact_table is not None:
-        if loads is not None:
-            raise SceneError("loads", "a scene with [exact] derives its loads from the exact "
-                             "solution; remove [loads]")
-        variables = coords + ("t",)
-        raw_u = exact_table.get("u", "list")
-        u = _vector_of_expressions("exact.u", raw_u, dim, variables)
-        beta = multiplier = None
-        exact_resolved = {"u": [str(v) for v in raw_u]}
-        if exact_table.has("beta"):
-            raw = exact_table.get("beta", "expr")
-            beta = _expression("exact.beta", raw, variables)
-            exact_resolved["beta"] = str(raw)
-            if beta.depends_on_time and contact.bonding.law == "none":
-                raise SceneError("exact.beta", "depends on t, but contact.bonding.law is "
-                                 "'none' (β frozen); use a bonding law")
-        if exact_table.has("multiplier"):
-            raw = exact_table.get("multiplier", "expr")
-            multiplier = _expression("exact.multiplier", raw, variables)
-            exact_resolved["multiplier"] = str(raw)
-        exact_table.finish()
-        if contact.beta0 is not None:
-            raise SceneError("contact.bonding.beta0", "a scene with [exact] takes β_0 from "
-                             "exact.beta; remove beta0")
-        exact = ExactSpec(u, beta, multiplier)
+    dirichlet, contact_sides = _read_boundary(top.table("boundary", required=True), dim)
+    material = _read_material(top.table("material", required=True), dim)
+    memory = _read_memory(top.table("memory"), dim)
+    body, traction = _read_loads(top.table("loads"), dim, dirichlet, contact_sides)
+    contact = _read_contact(top.table("contact"), dim, contact_sides)
+    T, steps = _read_time(top.table("time", required=True))
+    solver = _read_solver(top.table("solver"))
+    probes = _read_probes(top.table("output"), dim)
+    exact = _read_exact(top.table("exact"), dim, contact, top.has("loads"))
     top.finish()
-
-    resolved = {
-        "title": title, "dim": dim,
-        "mesh": {"domain": mesh.domain, "size": list(mesh.size), "cells": list(mesh.cells),
-                 "pattern": mesh.pattern, "refine": mesh.refine},
-        "boundary": {"dirichlet": list(dirichlet), "contact": list(contact_sides)},
-        "material": {**material_resolved, "lam": material.lam, "mu": material.mu},
-        "memory": memory_resolved,
-        "loads": loads_resolved,
-        "contact": contact_resolved,
-        "time": {"T": T, "steps": steps, "k": T / steps},
-        "solver": {"method": solver.method, "tol": solver.tol, "max_iter": solver.max_iter},
-        "output": {"probes": [list(p) for p in probes]},
-        "exact": exact_resolved,
-    }
     return Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
-                 traction, contact, T, steps, solver, probes, exact, resolved)
+                 traction, contact, T, steps, solver, probes, exact)
 
 
 def parse_scene(text):

@@ -42,15 +42,15 @@ def boundary_mass(u, v, w):
 def trace_constant_squared(scene):
     """λ_max of ∫_{Γ_C} u·v = λ ∫_Ω ε(u):ε(v) on the scene's unrefined mesh."""
     mesh = build_mesh(replace(scene.mesh, refine=0))
-    asm_ = Assembly(mesh)
+    assembly = Assembly(mesh)
     d = mesh.dim()
     clamped_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
-    clamped = np.unique(asm_.nodal_dofs[:, np.unique(mesh.facets[:, clamped_facets])])
-    free = np.setdiff1d(np.arange(asm_.ndofs), clamped)
+    clamped = np.unique(assembly.nodal_dofs[:, np.unique(mesh.facets[:, clamped_facets])])
+    free = np.setdiff1d(np.arange(assembly.ndofs), clamped)
     facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
     fb = FacetBasis(mesh, vector_element(d), facets=facets, intorder=2)
     M = asm(boundary_mass, fb).tocsr()[free][:, free]
-    E = (0.5 * asm_.K_mu).tocsr()[free][:, free]   # ∫ ε(u):ε(v)
+    E = (0.5 * assembly.K_mu).tocsr()[free][:, free]   # ∫ ε(u):ε(v)
     if free.size <= 300:
         vals = la.eigh(M.toarray(), E.toarray(), eigvals_only=True,
                        subset_by_index=[free.size - 1, free.size - 1])
@@ -66,7 +66,7 @@ def smallness(scene, normal_law, friction):
     lam, mu = scene.material.lam, scene.material.mu
     m_A = min(2.0 * mu, scene.dim * lam + 2.0 * mu)
     m_nu = float(normal_law.lipschitz)
-    m_tau = 0.0 if friction is None else float(friction.relaxation)
+    m_tau = 0.0 if friction is None else float(friction.m_tau)
     ce2 = trace_constant_squared(scene) if scene.contact_sides else 0.0
     rhs = (m_tau + m_nu) * ce2
     m_c = 0.0 if friction is None else float(friction.nonconvexity)

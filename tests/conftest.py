@@ -1,10 +1,15 @@
-"""Shared helpers for the verification tests (elasticity, contact solver,
-memory): run a scene through the library, and build the independent
+"""Shared helpers for the tests: scene documents built from small changes
+to a base (``scene_dict``) and written as TOML for the command line
+(``to_toml``); run a scene through the library, and build the independent
 reference quantities (meshes, stiffness, loads) straight from scikit-fem.
 
 Nothing here calls the library's assembly, load map or contact boundary:
 the references must not share code with what they check.
 """
+
+import copy
+import json
+import re
 
 import numpy as np
 import pytest
@@ -20,12 +25,105 @@ from skfem import (
 )
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from adhesive_contact import build_problem, parse_scene, solve
+from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
+
+# ---------------------------------------------------------------- scene documents
+
+#: a 2 × 0.5 strip of 16 × 4 cells clamped on top, Γ_C at the bottom, one step
+BLOCK = {
+    "dim": 2,
+    "mesh": {"domain": "rectangle", "size": [2.0, 0.5], "cells": [16, 4]},
+    "boundary": {"dirichlet": ["top"], "contact": ["bottom"]},
+    "material": {"E": 1000.0, "nu": 0.3},
+    "time": {"T": 1.0, "steps": 1},
+}
+
+#: the value of a change that removes the key
+DELETE = object()
 
 
-def run(toml_text):
-    """(problem, solution) of a TOML scene."""
-    problem = build_problem(parse_scene(toml_text))
+def scene_dict(changes=None, base=BLOCK):
+    """A scene document: a copy of ``base`` with ``changes`` applied.
+
+    ``changes`` maps dotted keys to values, in order: ``{"mesh.cells": [8, 4],
+    "contact.normal": law("compliance", c=5.0), "loads": DELETE}`` sets
+    ``mesh.cells``, sets the whole [contact.normal] table (creating
+    [contact]) and removes [loads].
+    """
+    data = copy.deepcopy(base)
+    for dotted, value in (changes or {}).items():
+        *head, last = dotted.split(".")
+        table = data
+        for key in head:
+            table = table.setdefault(key, {})
+        if value is DELETE:
+            del table[last]
+        else:
+            table[last] = copy.deepcopy(value)
+    return data
+
+
+def law(name, **params):
+    """A law table {"law": name, **params}."""
+    return {"law": name, **params}
+
+
+def prony(*terms):
+    """A [memory] table of Prony terms given as (E, nu, tau)."""
+    return {"kernel": "prony",
+            "terms": [{"E": E, "nu": nu, "tau": tau} for E, nu, tau in terms]}
+
+
+def to_toml(data):
+    """The TOML text of a scene document (tomllib reads, but cannot write).
+
+    Tables become ``[a.b]`` sections, lists of tables ``[[a.b]]`` ones; the
+    values are strings, numbers, booleans and lists of them.
+    """
+    lines = []
+    _write_table(lines, data, ())
+    return "\n".join(lines).strip() + "\n"
+
+
+def _is_tables(value):
+    return isinstance(value, list) and value and all(isinstance(v, dict) for v in value)
+
+
+def _write_table(lines, table, path, header=None):
+    if header:
+        lines += ["", header]
+    for key, value in table.items():
+        if not isinstance(value, dict) and not _is_tables(value):
+            lines.append(f"{_toml_key(key)} = {_toml_value(value)}")
+    for key, value in table.items():
+        name = ".".join(_toml_key(k) for k in path + (key,))
+        if isinstance(value, dict):
+            _write_table(lines, value, path + (key,), f"[{name}]")
+        elif _is_tables(value):
+            for item in value:
+                _write_table(lines, item, path + (key,), f"[[{name}]]")
+
+
+def _toml_key(key):
+    return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else json.dumps(key)
+
+
+def _toml_value(value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value)      # a TOML basic string
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"no TOML value for {value!r}")
+
+
+def run(scene):
+    """(problem, solution) of a scene document, or of its TOML text."""
+    scene = parse_scene(scene) if isinstance(scene, str) else scene_from_dict(scene)
+    problem = build_problem(scene)
     return problem, solve(problem)
 
 

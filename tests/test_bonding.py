@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import reference_mesh, run, same_mesh
+from conftest import law, reference_mesh, run, same_mesh, scene_dict
 
-from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
+from adhesive_contact import build_problem, scene_from_dict, solve
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 
@@ -157,34 +157,13 @@ GAMMA, LF = 25000.0, 0.01
 
 
 def frozen(steps, eps_a=0.0, beta0="1 - 0.2*x"):
-    return f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [{FROZEN_SIZE[0]}, {FROZEN_SIZE[1]}]
-cells = [{FROZEN_CELLS[0]}, {FROZEN_CELLS[1]}]
-[boundary]
-dirichlet = ["left"]
-contact = ["bottom"]
-[material]
-E = 1000.0
-nu = 0.3
-[loads.traction]
-right = ["0", "0.2"]
-[contact.normal]
-law = "compliance"
-c = 10000.0
-[contact.bonding]
-law = "fremond"
-beta0 = "{beta0}"
-gamma_nu = {GAMMA}
-gamma_tau = 0.0
-eps_a = {eps_a}
-L = {LF}
-[time]
-T = 1.0
-steps = {steps}
-"""
+    return scene_dict({
+        "mesh.size": list(FROZEN_SIZE), "mesh.cells": list(FROZEN_CELLS),
+        "boundary.dirichlet": ["left"], "loads.traction.right": ["0", "0.2"],
+        "contact.normal": law("compliance", c=10000.0),
+        "contact.bonding": law("fremond", beta0=beta0, gamma_nu=GAMMA, gamma_tau=0.0,
+                               eps_a=eps_a, L=LF),
+        "time.steps": steps})
 
 
 def stretch_at_vertices(problem, sol):
@@ -281,7 +260,7 @@ def test_beta0_projected_to_facet_means():
     np.testing.assert_allclose(problem.beta0, 0.5 + 0.25 * mid, rtol=0, atol=1e-15)
     np.testing.assert_array_equal(sol.beta[0], problem.beta0)
 
-    quadratic = build_problem(parse_scene(frozen(1, beta0="x*x/4")))
+    quadratic = build_problem(scene_from_dict(frozen(1, beta0="x*x/4")))
     mean = (x1 ** 3 - x0 ** 3) / (12 * (x1 - x0))   # (1/|f|) ∫_f x²/4
     np.testing.assert_allclose(quadratic.beta0, mean, rtol=0, atol=1e-15)
     assert np.abs(quadratic.beta0 - mid ** 2 / 4).min() > 1e-4   # not the midpoint value

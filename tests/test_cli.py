@@ -10,49 +10,18 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
+from conftest import DELETE, law, prony, scene_dict, to_toml
 
 from adhesive_contact import build_problem, parse_scene
 
 # an 8x4 block hanging from its top, pulled down onto a wall with a gap that
 # is smallest in the middle: the wall becomes active at step 1 (7 nodes)
-SCENE = """\
-title = "test block"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [8, 4]
-
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[loads]
-body = ["0", "-400*t"]
-
-[contact]
-gap = "0.002 + 0.01*(x - 1)**2"
-
-[contact.normal]
-law = "compliance"
-c = 5000.0
-
-[time]
-T = 1.0
-steps = 3
-
-[output]
-probes = [[1.0, 0.0], [0.0, 0.5]]
-"""
+BLOCK = scene_dict({
+    "title": "test block", "mesh.size": [2.0, 1.0], "mesh.cells": [8, 4],
+    "memory": prony((200.0, 0.3, 0.5)), "loads.body": ["0", "-400*t"],
+    "contact.gap": "0.002 + 0.01*(x - 1)**2", "contact.normal": law("compliance", c=5000.0),
+    "time.steps": 3, "output.probes": [[1.0, 0.0], [0.0, 0.5]]})
+SCENE = to_toml(BLOCK)
 
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
@@ -263,8 +232,7 @@ def test_stale_outputs_of_a_previous_run_are_removed(tmp_path):
     out = tmp_path / "out"
     (tmp_path / "scene.toml").write_text(SCENE)
     assert run("solve", tmp_path / "scene.toml", "--out", out).exit_code == 0
-    no_contact = edit(SCENE, 'contact = ["bottom"]', "contact = []")
-    no_contact = no_contact[:no_contact.index("[contact]")] + no_contact[no_contact.index("[time]"):]
+    no_contact = to_toml(scene_dict({"boundary.contact": [], "contact": DELETE}, BLOCK))
     (tmp_path / "free.toml").write_text(no_contact)
     result = run("solve", tmp_path / "free.toml", "--out", out)
     assert result.exit_code == 0, result.stderr
@@ -293,8 +261,7 @@ def test_default_scene_default_out_is_default(tmp_path, monkeypatch):
 
 
 def test_scene_without_contact_skips_contact_outputs(tmp_path):
-    text = edit(SCENE, 'contact = ["bottom"]\n', "")
-    text = text[:text.index("[contact]")] + text[text.index("[time]"):]
+    text = to_toml(scene_dict({"boundary.contact": DELETE, "contact": DELETE}, BLOCK))
     (tmp_path / "scene.toml").write_text(text)
     out = tmp_path / "out"
     result = run("solve", tmp_path / "scene.toml", "--out", out)
@@ -316,11 +283,9 @@ def test_scene_without_contact_skips_contact_outputs(tmp_path):
 
 
 def test_solve_in_3d(tmp_path):
-    text = SCENE.replace('dim = 2', 'dim = 3').replace('"rectangle"', '"box"')
-    text = text.replace("size = [2.0, 1.0]", "size = [2.0, 1.0, 1.0]")
-    text = text.replace("cells = [8, 4]", "cells = [2, 2, 2]")
-    text = text.replace('body = ["0", "-400*t"]', 'body = ["0", "-400*t", "0"]')
-    text = text.replace("probes = [[1.0, 0.0], [0.0, 0.5]]", "probes = [[1.0, 0.0, 0.5]]")
+    text = to_toml(scene_dict({
+        "dim": 3, "mesh.domain": "box", "mesh.size": [2.0, 1.0, 1.0], "mesh.cells": [2, 2, 2],
+        "loads.body": ["0", "-400*t", "0"], "output.probes": [[1.0, 0.0, 0.5]]}, BLOCK))
     (tmp_path / "scene.toml").write_text(text)
     out = tmp_path / "out"
     result = run("solve", tmp_path / "scene.toml", "--out", out)
@@ -339,27 +304,23 @@ def test_solve_in_3d(tmp_path):
 
 
 BAD_SCENES = [
-    # (id, old text, new text, what the message must contain)
-    ("unknown key", "size = [2.0, 1.0]\n", "size = [2.0, 1.0]\nsise = [2.0, 1.0]\n",
-     "mesh.sise"),
-    ("cells 0", "cells = [8, 4]", "cells = [0, 8]", "mesh.cells"),
-    ("missing E", "E = 1000.0\n", "", "material.E"),
-    ("steps not int", "steps = 3", 'steps = "ten"', "time.steps"),
-    ("E zero", "E = 1000.0", "E = 0.0", "material.E"),
-    ("E negative", "E = 1000.0", "E = -5.0", "material.E"),
-    ("nu 0.5", "nu = 0.3\n\n[memory]", "nu = 0.5\n\n[memory]", "material.nu"),
-    ("T zero", "T = 1.0", "T = 0.0", "time.T"),
-    ("T negative", "T = 1.0", "T = -1.0", "time.T"),
-    ("steps zero", "steps = 3", "steps = 0", "time.steps"),
-    ("prony tau", "tau = 0.5", "tau = 0.0", "memory.terms[0].tau"),
-    ("unknown side", 'dirichlet = ["top"]', 'dirichlet = ["middle"]', "boundary.dirichlet"),
-    ("disallowed name", 'body = ["0", "-400*t"]', """body = ["0", "__import__('os')"]""",
-     "loads.body[1]"),
-    ("attribute access", 'body = ["0", "-400*t"]', 'body = ["0", "t.real"]', "loads.body[1]"),
-    ("probe outside", "probes = [[1.0, 0.0], [0.0, 0.5]]", "probes = [[1.0, 0.0], [5.0, 0.5]]",
-     "output.probes[1]"),
-    ("negative gap", 'gap = "0.002 + 0.01*(x - 1)**2"', 'gap = "0.002 - 0.01*x"', "contact.gap"),
-    ("invalid TOML", "dim = 2", "dim = = 2", "TOML"),
+    # (id, changes to BLOCK, what the message must contain)
+    ("unknown key", {"mesh.sise": [2.0, 1.0]}, "mesh.sise"),
+    ("cells 0", {"mesh.cells": [0, 8]}, "mesh.cells"),
+    ("missing E", {"material.E": DELETE}, "material.E"),
+    ("steps not int", {"time.steps": "ten"}, "time.steps"),
+    ("E zero", {"material.E": 0.0}, "material.E"),
+    ("E negative", {"material.E": -5.0}, "material.E"),
+    ("nu 0.5", {"material.nu": 0.5}, "material.nu"),
+    ("T zero", {"time.T": 0.0}, "time.T"),
+    ("T negative", {"time.T": -1.0}, "time.T"),
+    ("steps zero", {"time.steps": 0}, "time.steps"),
+    ("prony tau", {"memory": prony((200.0, 0.3, 0.0))}, "memory.terms[0].tau"),
+    ("unknown side", {"boundary.dirichlet": ["middle"]}, "boundary.dirichlet"),
+    ("disallowed name", {"loads.body": ["0", "__import__('os')"]}, "loads.body[1]"),
+    ("attribute access", {"loads.body": ["0", "t.real"]}, "loads.body[1]"),
+    ("probe outside", {"output.probes": [[1.0, 0.0], [5.0, 0.5]]}, "output.probes[1]"),
+    ("negative gap", {"contact.gap": "0.002 - 0.01*x"}, "contact.gap"),
 ]
 
 
@@ -372,13 +333,21 @@ def assert_one_line_error(result, code, needle):
     assert "Traceback" not in result.stderr + result.stdout
 
 
-@pytest.mark.parametrize("old, new, key", [case[1:] for case in BAD_SCENES],
+@pytest.mark.parametrize("changes, key", [case[1:] for case in BAD_SCENES],
                          ids=[case[0] for case in BAD_SCENES])
-def test_bad_scene_exits_2_with_one_line_naming_the_key(tmp_path, old, new, key):
+def test_bad_scene_exits_2_with_one_line_naming_the_key(tmp_path, changes, key):
     scene = tmp_path / "scene.toml"
-    scene.write_text(edit(SCENE, old, new))
+    scene.write_text(to_toml(scene_dict(changes, BLOCK)))
     result = run("solve", scene, "--out", tmp_path / "out")
     assert_one_line_error(result, 2, key)
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written
+
+
+def test_invalid_toml_exits_2_with_one_line(tmp_path):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(edit(SCENE, "dim = 2", "dim = = 2"))
+    result = run("solve", scene, "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "TOML")
     assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written
 
 
@@ -417,7 +386,7 @@ def test_out_that_is_a_file_exits_2(tmp_path):
 
 def test_solver_failure_exits_1_and_keeps_the_levels_before_it(tmp_path):
     scene = tmp_path / "scene.toml"
-    scene.write_text(edit(SCENE, "[output]", "[solver]\nmax_iter = 1\n\n[output]"))
+    scene.write_text(to_toml(scene_dict({"solver.max_iter": 1}, BLOCK)))
     out = tmp_path / "out"
     result = run("solve", scene, "--out", out)
     assert result.exit_code == 1, (result.stdout, result.stderr)
@@ -439,7 +408,7 @@ def test_solver_failure_exits_1_and_keeps_the_levels_before_it(tmp_path):
 def test_the_failing_scene_converges_with_more_iterations(tmp_path):
     """The failure above is the iteration cap: with it lifted the wall is active."""
     scene = tmp_path / "scene.toml"
-    scene.write_text(edit(SCENE, "[output]", "[solver]\nmax_iter = 50\n\n[output]"))
+    scene.write_text(to_toml(scene_dict({"solver.max_iter": 50}, BLOCK)))
     result = run("solve", scene, "--out", tmp_path / "out")
     assert result.exit_code == 0, result.stderr
     steps = strict_json(tmp_path / "out" / "summary.json")["steps"]
@@ -452,63 +421,19 @@ def test_the_failing_scene_converges_with_more_iterations(tmp_path):
 # the glue (adhesive_compliance + adhesive_spring) holds while Fremond's law
 # debonds the right end; Tresca friction sticks the left part of Γ_C
 
-FRICTION = """\
-[[contact.friction]]
-law = "tresca"
-mu = 1.0
+FRICTION = [law("tresca", mu=1.0), law("adhesive_spring", gamma=2000.0, L=0.01)]
 
-[[contact.friction]]
-law = "adhesive_spring"
-gamma = 2000.0
-L = 0.01
-"""
-
-GLUED = f"""\
-title = "glued strip"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [2.0, 0.5]
-cells = [8, 2]
-
-[boundary]
-dirichlet = ["left"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{{ E = 200.0, nu = 0.3, tau = 0.5 }}]
-
-[loads.traction]
-right = ["20*t", "40*t"]
-
-[contact]
-gap = 0.05
-
-[contact.normal]
-law = "adhesive_compliance"
-c = 10000.0
-gamma = 5000.0
-L = 0.01
-
-{FRICTION}
-[contact.bonding]
-law = "fremond"
-beta0 = 1.0
-gamma_nu = 15000.0
-gamma_tau = 7500.0
-eps_a = 0.0
-L = 0.01
-
-[time]
-T = 1.0
-steps = 3
-"""
+GLUED_SCENE = scene_dict({
+    "title": "glued strip", "mesh.cells": [8, 2], "boundary.dirichlet": ["left"],
+    "memory": prony((200.0, 0.3, 0.5)), "loads.traction.right": ["20*t", "40*t"],
+    "contact": {
+        "gap": 0.05,
+        "normal": law("adhesive_compliance", c=10000.0, gamma=5000.0, L=0.01),
+        "friction": FRICTION,
+        "bonding": law("fremond", beta0=1.0, gamma_nu=15000.0, gamma_tau=7500.0, eps_a=0.0,
+                       L=0.01)},
+    "time.steps": 3})
+GLUED = to_toml(GLUED_SCENE)
 
 GLUED_NODES, GLUED_FACETS = 8, 8   # the bottom vertex on Γ_D is not a contact node
 
@@ -624,30 +549,29 @@ def test_glued_plots_are_written(glued):
 
 
 BAD_LAWS = [
-    # (id, old text, new text, what the message must contain)
-    ("coulomb", FRICTION, '[contact.friction]\nlaw = "coulomb"\nmu = 1.0\n',
-     "contact.friction.law"),
-    ("nonmonotone a <= b", FRICTION,
-     '[contact.friction]\nlaw = "nonmonotone"\na = 1.0\nb = 2.0\nalpha = 5.0\n',
+    # (id, changes to GLUED_SCENE, what the message must contain)
+    ("coulomb", {"contact.friction": law("coulomb", mu=1.0)}, "contact.friction.law"),
+    ("nonmonotone a <= b", {"contact.friction": law("nonmonotone", a=1.0, b=2.0, alpha=5.0)},
      "contact.friction.a"),
-    ("nonmonotone a = b in a list", 'law = "tresca"\nmu = 1.0\n',
-     'law = "nonmonotone"\na = 1.0\nb = 1.0\nalpha = 5.0\n', "contact.friction[0].a"),
-    ("power q 1.5", 'law = "tresca"\nmu = 1.0\n', 'law = "power"\nmu = 1.0\nq = 1.5\n',
+    ("nonmonotone a = b in a list",
+     {"contact.friction": [law("nonmonotone", a=1.0, b=1.0, alpha=5.0), FRICTION[1]]},
+     "contact.friction[0].a"),
+    ("power q 1.5", {"contact.friction": [law("power", mu=1.0, q=1.5), FRICTION[1]]},
      "contact.friction[0].q"),
-    ("friction entry missing L", 'law = "adhesive_spring"\ngamma = 2000.0\nL = 0.01\n',
-     'law = "adhesive_spring"\ngamma = 2000.0\n', "contact.friction[1].L"),
-    ("bonding glue", 'law = "fremond"', 'law = "glue"', "contact.bonding.law"),
-    ("bonding beta0 1.5", "beta0 = 1.0", "beta0 = 1.5", "contact.bonding.beta0"),
-    ("tresca with gauss", "gap = 0.05\n", 'gap = 0.05\nquadrature = "gauss"\n',
-     "contact.quadrature"),
+    ("friction entry missing L",
+     {"contact.friction": [FRICTION[0], law("adhesive_spring", gamma=2000.0)]},
+     "contact.friction[1].L"),
+    ("bonding glue", {"contact.bonding.law": "glue"}, "contact.bonding.law"),
+    ("bonding beta0 1.5", {"contact.bonding.beta0": 1.5}, "contact.bonding.beta0"),
+    ("tresca with gauss", {"contact.quadrature": "gauss"}, "contact.quadrature"),
 ]
 
 
-@pytest.mark.parametrize("old, new, key", [case[1:] for case in BAD_LAWS],
+@pytest.mark.parametrize("changes, key", [case[1:] for case in BAD_LAWS],
                          ids=[case[0] for case in BAD_LAWS])
-def test_bad_law_exits_2_with_one_line_naming_the_key(tmp_path, old, new, key):
+def test_bad_law_exits_2_with_one_line_naming_the_key(tmp_path, changes, key):
     scene = tmp_path / "scene.toml"
-    scene.write_text(edit(GLUED, old, new))
+    scene.write_text(to_toml(scene_dict(changes, GLUED_SCENE)))
     result = run("solve", scene, "--out", tmp_path / "out")
     assert_one_line_error(result, 2, key)
     assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written

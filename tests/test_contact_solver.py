@@ -25,11 +25,13 @@ import pytest
 import scipy.sparse as sp
 from conftest import (
     clamped_dofs,
+    law,
     load_vector,
     reference_mesh,
     relative_max,
     run,
     same_mesh,
+    scene_dict,
     stiffness,
 )
 from scipy.optimize import minimize
@@ -55,31 +57,11 @@ def scene(case, quadrature):
     # The body loads are polynomials (degree ≤ 2), integrated exactly by the
     # library's rule and by ours, so both minimise the same energy.
     gap, _, clamped, load, _ = CASES[case]
-    return f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 0.5]
-cells = [16, 8]
-[boundary]
-dirichlet = ["{clamped}"]
-contact = ["bottom"]
-[material]
-E = {E!r}
-nu = {NU!r}
-[loads]
-body = ["0", "{load}"]
-[contact]
-gap = "{gap}"
-quadrature = "{quadrature}"
-order = 4
-[contact.normal]
-law = "compliance"
-c = {C!r}
-[time]
-T = 1.0
-steps = 1
-"""
+    return scene_dict({
+        "mesh.size": list(SIZE), "mesh.cells": list(CELLS), "boundary.dirichlet": [clamped],
+        "material": {"E": E, "nu": NU}, "loads.body": ["0", load],
+        "contact": {"gap": gap, "quadrature": quadrature, "order": 4,
+                    "normal": law("compliance", c=C)}})
 
 
 def _sq_diff(s, q):

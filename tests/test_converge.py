@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
+from conftest import law, prony, scene_dict, to_toml
 
 import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, parse_scene
@@ -19,70 +20,19 @@ from adhesive_contact.convergence import default_reference_refinement, run_refer
 
 # no contact: u* is smooth and the library derives body force and tractions;
 # 8 steps keep the time error below the space error of the 3 levels
-EXACT_SCENE = """\
-title = "manufactured, no contact"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [1.0, 0.5]
-cells = [4, 2]
-
-[boundary]
-dirichlet = ["left"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[time]
-T = 1.0
-steps = 8
-
-[exact]
-u = ["0.01*x*x*(1+t)", "0.005*x*y"]
-"""
+EXACT = scene_dict({
+    "title": "manufactured, no contact", "mesh.size": [1.0, 0.5], "mesh.cells": [4, 2],
+    "boundary": {"dirichlet": ["left"]}, "memory": prony((200.0, 0.3, 0.5)),
+    "time.steps": 8, "exact.u": ["0.01*x*x*(1+t)", "0.005*x*y"]})
 
 # a block hanging from its top, pressed by its weight onto a compliant wall
-CONTACT_SCENE = """\
-title = "small block on a compliant wall"
-dim = 2
+CONTACT = scene_dict({
+    "title": "small block on a compliant wall", "mesh.size": [1.0, 0.5],
+    "mesh.cells": [4, 2], "memory": prony((200.0, 0.3, 0.5)),
+    "loads.body": ["0", "-400*t"], "contact.gap": "0.001 + 0.01*(x - 0.5)**2",
+    "contact.normal": law("compliance", c=300.0), "time.steps": 2})
 
-[mesh]
-domain = "rectangle"
-size = [1.0, 0.5]
-cells = [4, 2]
-
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[loads]
-body = ["0", "-400*t"]
-
-[contact]
-gap = "0.001 + 0.01*(x - 0.5)**2"
-
-[contact.normal]
-law = "compliance"
-c = 300.0
-
-[time]
-T = 1.0
-steps = 2
-"""
+EXACT_SCENE, CONTACT_SCENE = to_toml(EXACT), to_toml(CONTACT)
 
 REF_K = default_reference_refinement("k")[1]
 FIRM_LEVEL_KEYS = {"h", "k", "dofs", "err_u", "err_beta", "E", "seconds"}
@@ -342,7 +292,7 @@ def test_another_study_in_the_same_out_exits_2(fine_study, tmp_path, scenes, cha
     scene = scenes.contact
     if change == "scene":
         scene = tmp_path / "contact.toml"
-        scene.write_text(CONTACT_SCENE.replace("c = 300.0", "c = 400.0"))
+        scene.write_text(to_toml(scene_dict({"contact.normal.c": 400.0}, CONTACT)))
     else:
         args[change[0]] = change[1]
     flat = [item for pair in args.items() for item in pair]
@@ -396,7 +346,7 @@ def test_ref_refinement_with_exact_reference_exits_2(tmp_path, scenes):
 
 def test_bad_scene_exits_2_and_writes_nothing(tmp_path):
     scene = tmp_path / "bad.toml"
-    scene.write_text(CONTACT_SCENE.replace("nu = 0.3\n\n[memory]", "nu = 0.7\n\n[memory]"))
+    scene.write_text(to_toml(scene_dict({"material.nu": 0.7}, CONTACT)))
     result = run(scene, "--param", "h", "--out", tmp_path / "out")
     assert_one_line_error(result, 2, "nu")
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
@@ -422,8 +372,8 @@ def test_step_failure_exits_1_in_the_reference_and_in_a_worker(fine_study, tmp_p
     reference failure leaves study.json only; with a reference in place the
     levels fail in the worker processes, and the message reaches the user."""
     scene = tmp_path / "fail.toml"
-    scene.write_text(CONTACT_SCENE.replace("c = 300.0", "c = 5000.0")
-                     + "\n[solver]\nmax_iter = 1\n")
+    scene.write_text(to_toml(scene_dict({"contact.normal.c": 5000.0, "solver.max_iter": 1},
+                                        CONTACT)))
     out = tmp_path / "out"
     args = (scene, "--param", "k", "--levels", 3, "--jobs", 2, "--out", out)
     result = run(*args)
@@ -475,10 +425,9 @@ def test_finished_study_rerun_with_jobs_computes_nothing(fine_study, tmp_path, s
 
 
 def test_fine_reference_in_3d_with_contact_exits_2(tmp_path):
-    text = (CONTACT_SCENE.replace("dim = 2", "dim = 3").replace('"rectangle"', '"box"')
-            .replace("size = [1.0, 0.5]", "size = [1.0, 0.5, 0.5]")
-            .replace("cells = [4, 2]", "cells = [2, 1, 1]")
-            .replace('body = ["0", "-400*t"]', 'body = ["0", "-400*t", "0"]'))
+    text = to_toml(scene_dict({"dim": 3, "mesh.domain": "box", "mesh.size": [1.0, 0.5, 0.5],
+                               "mesh.cells": [2, 1, 1], "loads.body": ["0", "-400*t", "0"]},
+                              CONTACT))
     path = tmp_path / "box.toml"
     path.write_text(text)
     result = run(path, "--param", "h", "--levels", 2, "--out", tmp_path / "out")

@@ -7,11 +7,14 @@ import numpy as np
 import pytest
 from conftest import (
     clamped_dofs,
+    law,
     load_vector,
+    prony,
     reference_mesh,
     relative_max,
     run,
     same_mesh,
+    scene_dict,
     stiffness,
 )
 from skfem import condense
@@ -35,26 +38,13 @@ def test_patch_linear_field_is_reproduced(pattern):
     is in V^h, so the Galerkin solution equals it up to round-off."""
     e1, e2 = 1.0e-3, 2.0e-3
     sxx, syy, sxy = (LAM + 2 * MU) * e1, LAM * e1, MU * e2
-    scene = f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [6, 3]
-pattern = "{pattern}"
-[boundary]
-dirichlet = ["left"]
-[material]
-E = {E!r}
-nu = {NU!r}
-[loads.traction]
-right = ["{sxx!r}*t", "{sxy!r}*t"]
-top = ["{sxy!r}*t", "{syy!r}*t"]
-bottom = ["{-sxy!r}*t", "{-syy!r}*t"]
-[time]
-T = 1.0
-steps = 2
-"""
+    scene = scene_dict({
+        "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [6, 3], "pattern": pattern},
+        "boundary": {"dirichlet": ["left"]}, "material": {"E": E, "nu": NU},
+        "loads.traction": {"right": [f"{sxx!r}*t", f"{sxy!r}*t"],
+                           "top": [f"{sxy!r}*t", f"{syy!r}*t"],
+                           "bottom": [f"{-sxy!r}*t", f"{-syy!r}*t"]},
+        "time.steps": 2})
     problem, sol = run(scene)
     x = problem.mesh.p[0]
     exact_eps = np.array([[e1, e2 / 2], [e2 / 2, 0.0]])
@@ -86,27 +76,14 @@ def test_no_contact_matches_plain_skfem(pattern):
     left. Reference: scikit-fem's linear_elasticity, LinearForms for the
     loads (exact rule for these polynomial loads), condense + solve."""
     size, cells = (2.0, 1.0), (8, 4)
-    scene = f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [8, 4]
-pattern = "{pattern}"
-[boundary]
-dirichlet = ["left"]
-[material]
-E = {E!r}
-nu = {NU!r}
-[loads]
-body = ["t*(3*x*y - 1)", "-t*(1 + x**2 - y)"]
-[loads.traction]
-right = ["5*t*y", "-2*t*(1 + y**2)"]
-top = ["0.5*t*x", "-t*x*(2 - x)"]
-[time]
-T = 1.0
-steps = 2
-"""
+    scene = scene_dict({
+        "mesh": {"domain": "rectangle", "size": list(size), "cells": list(cells),
+                 "pattern": pattern},
+        "boundary": {"dirichlet": ["left"]}, "material": {"E": E, "nu": NU},
+        "loads": {"body": ["t*(3*x*y - 1)", "-t*(1 + x**2 - y)"],
+                  "traction": {"right": ["5*t*y", "-2*t*(1 + y**2)"],
+                               "top": ["0.5*t*x", "-t*x*(2 - x)"]}},
+        "time.steps": 2})
     problem, sol = run(scene)
     mesh = reference_mesh(size, cells, pattern)
     same_mesh(problem, mesh)
@@ -135,35 +112,12 @@ steps = 2
 
 PRONY = [(200.0, 0.3, 0.5), (100.0, 0.25, 0.1)]   # (E_m, ν_m, τ_m)
 
-EQUILIBRIUM_SCENE = """
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [16, 8]
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-[material]
-E = 1000.0
-nu = 0.3
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }, { E = 100.0, nu = 0.25, tau = 0.1 }]
-[loads]
-body = ["10*t*y", "-300*t*(1 + 0.5*x)"]
-[loads.traction]
-right = ["-20*t*y", "-10*t"]
-left = ["15*t", "5*t*y"]
-[contact]
-gap = "0.004 + 0.004*x*(2 - x)"
-[contact.normal]
-law = "compliance"
-c = 10000.0
-[time]
-T = 1.0
-steps = 10
-"""
+EQUILIBRIUM_SCENE = scene_dict({
+    "mesh.size": [2.0, 1.0], "mesh.cells": [16, 8], "memory": prony(*PRONY),
+    "loads": {"body": ["10*t*y", "-300*t*(1 + 0.5*x)"],
+              "traction": {"right": ["-20*t*y", "-10*t"], "left": ["15*t", "5*t*y"]}},
+    "contact": {"gap": "0.004 + 0.004*x*(2 - x)", "normal": law("compliance", c=10000.0)},
+    "time.steps": 10})
 
 
 def exact_resultants(t):

@@ -69,6 +69,15 @@ def test_number_input():
         compile_expression(None)
 
 
+def test_an_expression_keeps_what_it_was_given():
+    text = compile_expression(" 2*x ")
+    assert (text.source, text.number, text.given) == (" 2*x ", None, " 2*x ")
+    for number, source in ((0.02, "0.02"), (-40, "-40"), (np.float64(1.5), "1.5")):
+        expr = compile_expression(number)
+        assert expr.source == source and expr.given is number
+        assert compile_expression(expr.source)(X)[0] == number   # the text reads back
+
+
 def test_uses_and_flags():
     expr = compile_expression("0.02 + 0.01*sin(pi*x) * t")
     assert isinstance(expr, Expression)
@@ -178,3 +187,24 @@ def test_no_builtin_eval_exec_compile_in_module():
             assert node.func.id not in {"eval", "exec", "compile",
                                         "__import__"}, node.func.id
     assert "builtins" not in inspect.getsource(expressions)
+
+
+def _call(name):
+    """A call of ``name`` with its arity, arguments in the domain of every function."""
+    return {1: f"{name}(0.3 + 0.4*x)", 2: f"{name}(0.3 + 0.4*x, 0.5 - 0.2*x)",
+            3: f"{name}(x < 0.5, 0.3 + x, 0.2*x)" if name == "where"
+            else f"{name}(x, 0.3, 0.6)"}[expressions.FUNCTIONS[name].arity]
+
+
+@pytest.mark.parametrize("name", list(expressions.FUNCTIONS))
+def test_numpy_and_sympy_forms_of_each_function_agree(name):
+    # the one function table gives both forms; manufactured solutions
+    # differentiate the sympy one, the time loop evaluates the NumPy one
+    import sympy
+
+    from adhesive_contact.manufactured import to_sympy
+    x = np.linspace(0.05, 0.95, 13)
+    expr = compile_expression(_call(name))
+    symbol = sympy.Symbol("x")
+    exact = sympy.lambdify(symbol, to_sympy(expr, {"x": symbol}), modules="numpy")
+    np.testing.assert_allclose(expr(x), exact(x) + 0 * x, rtol=1e-14, atol=0)

@@ -24,17 +24,19 @@ import numpy as np
 import pytest
 from conftest import (
     clamped_dofs,
+    law,
     load_vector,
     reference_mesh,
     relative_max,
     run,
     same_mesh,
+    scene_dict,
     stiffness,
 )
 from scipy.optimize import minimize
 from scipy.sparse.linalg import spsolve
 
-from adhesive_contact import StepFailure, build_problem, parse_scene, solve
+from adhesive_contact import StepFailure, build_problem, scene_from_dict, solve
 from adhesive_contact.scheme import STEP_FAILED, STOPPED
 from adhesive_contact.step_solver import MAX_ITERATIONS
 
@@ -42,31 +44,15 @@ E, NU, C = 1000.0, 0.3, 1.0e4
 SIZE, CELLS = (2.0, 0.5), (16, 4)
 
 
-def scene(friction, body, normal=f'law = "compliance"\nc = {C!r}', steps=1, solver=""):
-    """A scene of the setting; ``friction`` a list of TOML law bodies."""
-    tables = "".join(f"\n[[contact.friction]]\n{law}\n" for law in friction)
-    return f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [{SIZE[0]}, {SIZE[1]}]
-cells = [{CELLS[0]}, {CELLS[1]}]
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-[material]
-E = {E!r}
-nu = {NU!r}
-[loads]
-body = ["{body[0]}", "{body[1]}"]
-[contact.normal]
-{normal}
-{tables}
-[time]
-T = 1.0
-steps = {steps}
-{solver}
-"""
+def scene(friction, body, normal=None, steps=1, solver=None):
+    """A scene of the setting; ``friction`` a list of law tables."""
+    changes = {"mesh.size": list(SIZE), "mesh.cells": list(CELLS),
+               "material": {"E": E, "nu": NU}, "loads.body": list(body),
+               "contact.normal": normal or law("compliance", c=C),
+               "contact.friction": friction, "time.steps": steps}
+    if solver:
+        changes["solver"] = solver
+    return scene_dict(changes)
 
 
 # --------------------------------------------------------------------------
@@ -350,15 +336,15 @@ class Reference:
 
 
 # --------------------------------------------------------------------------
-# Cases: (normal law TOML, [friction TOML], body, normal, friction)
+# Cases: (normal law table, [friction law tables], body, normal, friction)
 # --------------------------------------------------------------------------
 
-COMPLIANCE = f'law = "compliance"\nc = {C!r}'
-ADHESIVE = f'law = "adhesive_compliance"\nc = {C!r}\ngamma = 5000.0\nL = 0.0005'
-TRESCA = 'law = "tresca"\nmu = 10.0'
-WEAKENING = 'law = "nonmonotone"\na = 10.0\nb = 8.5\nalpha = 200.0'
-POWER = 'law = "power"\nmu = 100.0\nq = 0.5'
-SPRING = 'law = "adhesive_spring"\ngamma = 1000.0\nL = 0.01'
+COMPLIANCE = law("compliance", c=C)
+ADHESIVE = law("adhesive_compliance", c=C, gamma=5000.0, L=0.0005)
+TRESCA = law("tresca", mu=10.0)
+WEAKENING = law("nonmonotone", a=10.0, b=8.5, alpha=200.0)
+POWER = law("power", mu=100.0, q=0.5)
+SPRING = law("adhesive_spring", gamma=1000.0, L=0.01)
 # the body force, as the scene's strings and as a function for load_vector
 PRESS = (("40*x", "-40"),           # sheared towards x = 2, pressed everywhere
          lambda x, y: (40.0 * x, -40.0 + 0 * x))
@@ -373,7 +359,7 @@ CASES = {
                     SlipWeakening(10.0, 8.5, 200.0)),
     "power": (COMPLIANCE, [POWER], PRESS, Compliance(C), Power(100.0, 0.5)),
     "adhesive_spring": (COMPLIANCE, [SPRING], PRESS, Compliance(C), Spring(1000.0, 0.01)),
-    "tresca+adhesive_spring": (COMPLIANCE, ['law = "tresca"\nmu = 6.0', SPRING], PRESS,
+    "tresca+adhesive_spring": (COMPLIANCE, [law("tresca", mu=6.0), SPRING], PRESS,
                                Compliance(C), Sum(Tresca(6.0), Spring(1000.0, 0.01))),
     "adhesive_compliance+tresca": (ADHESIVE, [TRESCA], LIFT,
                                    AdhesiveCompliance(C, 5000.0, 0.0005), Tresca(10.0)),
@@ -382,8 +368,8 @@ CASES = {
 
 @pytest.mark.parametrize("name", list(CASES))
 def test_step_equals_independent_minimiser(name):
-    normal_toml, friction_toml, body, normal, friction = CASES[name]
-    problem, sol = run(scene(friction_toml, body[0], normal_toml))
+    normal_table, friction_tables, body, normal, friction = CASES[name]
+    problem, sol = run(scene(friction_tables, body[0], normal_table))
     ref = Reference(body[1], normal, friction)
     same_mesh(problem, ref.mesh)
     np.testing.assert_array_equal(np.sort(problem.boundary.nodes), ref.nodes)
@@ -523,8 +509,8 @@ def test_slip_weakening_newton_iterations_bounded():
 def test_step_failure_names_the_step():
     """One Newton iteration cannot find the slip set: StepFailure at step 1
     (step 0 has no load and converges at once)."""
-    problem = build_problem(parse_scene(scene([TRESCA], ("150*x*t", "-80*t"), steps=2,
-                                              solver="[solver]\nmax_iter = 1")))
+    problem = build_problem(scene_from_dict(scene([TRESCA], ("150*x*t", "-80*t"), steps=2,
+                                                  solver={"max_iter": 1})))
     with pytest.raises(StepFailure) as info:
         solve(problem, raise_on_failure=True)
     err = info.value
@@ -537,8 +523,8 @@ def test_step_failure_names_the_step():
 def test_failed_step_is_a_returned_status_with_the_history_before_it():
     """Without raise_on_failure the same run returns: not successful, the
     failure named, and the one level that converged (t = 0) kept."""
-    problem = build_problem(parse_scene(scene([TRESCA], ("150*x*t", "-80*t"), steps=2,
-                                              solver="[solver]\nmax_iter = 1")))
+    problem = build_problem(scene_from_dict(scene([TRESCA], ("150*x*t", "-80*t"), steps=2,
+                                                  solver={"max_iter": 1})))
     sol = solve(problem)
     assert not sol.success and sol.status == STEP_FAILED
     assert sol.failure.n == 1 and sol.message == str(sol.failure)
@@ -548,7 +534,7 @@ def test_failed_step_is_a_returned_status_with_the_history_before_it():
 
 
 def test_progress_callback_can_stop_a_run():
-    problem = build_problem(parse_scene(scene([TRESCA], ("150*x*t", "-80*t"), steps=4)))
+    problem = build_problem(scene_from_dict(scene([TRESCA], ("150*x*t", "-80*t"), steps=4)))
     seen = []
     sol = solve(problem, progress=lambda n, N: seen.append(n) or n == 2)
     assert seen == [0, 1, 2] and sol.status == STOPPED and not sol.success
@@ -563,28 +549,9 @@ def test_power_law_near_zero_slip_converges():
     and sheared and pressed on top, so the contact node next to the clamp
     barely slides (u_τ ≈ −3e-9). The step energy is strictly convex and
     smooth; the globalised Newton must converge within its default budget."""
-    text = f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 0.5]
-cells = [16, 4]
-[boundary]
-dirichlet = ["left"]
-contact = ["bottom"]
-[material]
-E = {E!r}
-nu = {NU!r}
-[loads.traction]
-top = ["10", "-20"]
-[contact.normal]
-{COMPLIANCE}
-[[contact.friction]]
-{POWER}
-[time]
-T = 1.0
-steps = 1
-"""
-    problem, sol = run(text)
+    problem, sol = run(scene_dict({
+        "boundary.dirichlet": ["left"], "material": {"E": E, "nu": NU},
+        "loads.traction.top": ["10", "-20"],
+        "contact.normal": COMPLIANCE, "contact.friction": [POWER]}))
     print(f"\npower law near zero slip: Newton iterations {sol.iterations.tolist()}")
     assert np.all(sol.iterations <= 30)

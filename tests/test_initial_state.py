@@ -8,43 +8,23 @@ through the formed, dense Schur complement: the two paths must agree.
 
 import numpy as np
 import pytest
+from conftest import law, prony, scene_dict
 
-from adhesive_contact import build_problem, parse_scene, solve
+from adhesive_contact import build_problem, scene_from_dict, solve
 
-SCENE = """
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 0.5]
-cells = [16, 4]
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-[material]
-E = 1000.0
-nu = 0.3
-MEMORY
-[loads]
-body = ["30*(1 + x)", "-400 - 100*x*(1 + t)"]
-[contact]
-gap = "0.01 + 0.05*(x - 1)**2"
-[contact.normal]
-law = "compliance"
-c = 5000.0
-FRICTION
-[time]
-T = 1.0
-steps = 3
-"""
-MEMORY = '[memory]\nkernel = "prony"\nterms = [{ E = 300.0, nu = 0.3, tau = 0.2 }]'
+# the strip of conftest.BLOCK pressed onto a wall, sheared, for 3 steps
+CHANGES = {"loads.body": ["30*(1 + x)", "-400 - 100*x*(1 + t)"],
+         "contact.gap": "0.01 + 0.05*(x - 1)**2",
+         "contact.normal": law("compliance", c=5000.0), "time.steps": 3}
+MEMORY = prony((300.0, 0.3, 0.2))
 
 
-@pytest.mark.parametrize("friction", ["", '[contact.friction]\nlaw = "tresca"\nmu = 20.0'])
+@pytest.mark.parametrize("friction", [None, law("tresca", mu=20.0)])
 def test_initial_state_with_memory_equals_the_elastic_problem(friction):
-    with_memory = solve(build_problem(parse_scene(
-        SCENE.replace("MEMORY", MEMORY).replace("FRICTION", friction))))
-    without = solve(build_problem(parse_scene(
-        SCENE.replace("MEMORY", "").replace("FRICTION", friction))))
+    changes = {**CHANGES, "contact.friction": friction} if friction else CHANGES
+    with_memory = solve(build_problem(scene_from_dict(scene_dict({**changes,
+                                                                   "memory": MEMORY}))))
+    without = solve(build_problem(scene_from_dict(scene_dict(changes))))
     u0, ref = with_memory.u[0], without.u[0]
     # the case exercises the wall and (with friction) both stick and slip
     assert with_memory.on_wall[0].any() and not with_memory.on_wall[0].all()

@@ -215,8 +215,8 @@ def lipschitz_ratios(law, seed):
 
 @pytest.mark.parametrize("params", ADHESIVE_REGIMES, ids=str)
 def test_adhesive_compliance_is_lipschitz_with_m_nu(params):
-    # H(p_ν)(b) with the law's m_ν, which must not exceed the constant
-    # max(c + γ, 2γL) stated in MODEL.md §6 (itself a valid bound)
+    # H(p_ν)(b) with the law's m_ν = max(c, γ, 2γL), which cannot exceed the
+    # plain sum of the slopes max(c + γ, 2γL) (also a valid bound)
     law = AdhesiveCompliance(**params)
     assert law.lipschitz <= max(law.c + law.gamma, 2 * law.gamma * law.L)
     ratio, rounding = lipschitz_ratios(law, 4)
@@ -383,7 +383,21 @@ def test_friction_sum_kink_and_constants_are_sums():
     assert np.allclose(both.kink(beta), 0.3 + 0.8, rtol=4 * EPS, atol=0)
     assert both.has_kink and FrictionSum((sw,)).has_kink
     assert not FrictionSum((p, sp)).has_kink
-    assert FrictionSum((t, sw, p, sp)).relaxation == pytest.approx(4.0 * 0.5 + 2 * 2.0 * 0.8)
+    assert FrictionSum((t, sw, p, sp)).m_tau == pytest.approx(4.0 * 0.5 + 2 * 2.0 * 0.8)
+
+
+@pytest.mark.parametrize("law", FRICTION[:5], ids=repr)
+def test_has_kink_says_whether_the_friction_bound_is_positive(law):
+    beta = np.linspace(0.0, 1.0, 5)
+    assert type(law).has_kink == bool(np.all(law.kink(beta[1:]) > 0))
+    assert np.all(law.kink(beta) >= 0)
+    assert type(law) in {cls for cls, _ in FRICTION_LAWS.values()}
+
+
+def test_every_registered_friction_law_says_whether_it_has_a_kink():
+    classes = {cls for cls, _ in FRICTION_LAWS.values() if cls is not None}
+    assert classes == {type(law) for law in FRICTION[:5]}   # each one tested above
+    assert all(isinstance(cls.has_kink, bool) for cls in classes)
 
 
 @pytest.mark.parametrize("law", FRICTION[:5], ids=repr)
@@ -450,7 +464,7 @@ def gradient_1d(law, xi):
 
 def test_slip_weakening_is_relaxed_monotone_with_sharp_constant():
     law = SlipWeakening(a=0.8, b=0.3, alpha=4.0)
-    m = law.relaxation
+    m = law.m_tau
     assert m == pytest.approx(4.0 * 0.5)
     rng = np.random.default_rng(7)
     x1, x2 = rng.uniform(-2, 2, (2, 20000))
@@ -477,7 +491,7 @@ def test_adhesive_spring_is_relaxed_monotone_in_beta_and_xi():
     dxi = np.linalg.norm(x1 - x2, axis=-1)
     g1, g2 = fs.gradient(b1, x1), fs.gradient(b2, x2)
     lhs = np.sum((g1 - g2) * (x1 - x2), axis=-1)
-    rhs = -law.relaxation * (np.abs(b1 - b2) + dxi) * dxi
+    rhs = -law.m_tau * (np.abs(b1 - b2) + dxi) * dxi
     rounding = 8 * EPS * (np.linalg.norm(g1, axis=-1) + np.linalg.norm(g2, axis=-1)) * dxi
     assert np.all(lhs >= rhs * (1 + SLACK) - rounding)
 

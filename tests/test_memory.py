@@ -6,7 +6,7 @@ equation (first order in k).
 
 import numpy as np
 import pytest
-from conftest import relative_max, run
+from conftest import prony, relative_max, run, scene_dict
 from scipy.integrate import quad
 
 from adhesive_contact import compile_expression
@@ -96,28 +96,13 @@ def exact_strain(t):
 
 
 def column_scene(steps, kernel="prony"):
-    memory = (f'kernel = "prony"\nterms = [{{ E = {EM!r}, nu = 0.0, tau = {TAU!r} }}]'
-              if kernel == "prony" else
-              f'kernel = "function"\nr = "exp(-t/{TAU!r})"\nE = {EM!r}\nnu = 0.0')
-    return f"""
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [4.0, 1.0]
-cells = [8, 2]
-[boundary]
-dirichlet = ["left"]
-[material]
-E = {E0!r}
-nu = 0.0
-[memory]
-{memory}
-[loads.traction]
-right = ["{S0!r}", "0"]
-[time]
-T = {T_END!r}
-steps = {steps}
-"""
+    memory = (prony((EM, 0.0, TAU)) if kernel == "prony" else
+              {"kernel": "function", "r": f"exp(-t/{TAU!r})", "E": EM, "nu": 0.0})
+    return scene_dict({
+        "mesh.size": [4.0, 1.0], "mesh.cells": [8, 2],
+        "boundary": {"dirichlet": ["left"]}, "material": {"E": E0, "nu": 0.0},
+        "memory": memory, "loads.traction.right": [repr(S0), "0"],
+        "time": {"T": T_END, "steps": steps}})
 
 
 def column_strain(problem, sol):

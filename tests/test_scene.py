@@ -1,41 +1,24 @@
 """The scene reader: resolved values, and one clear error per bad input."""
 
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import DELETE, law, scene_dict, to_toml
 
 from adhesive_contact import SceneError, build_problem, parse_scene, scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
-BASE = """
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [4, 2]
-[boundary]
-dirichlet = ["left"]
-contact = ["bottom"]
-[material]
-E = 1000.0
-nu = 0.25
-[loads.traction]
-top = ["0", "-t"]
-[contact]
-gap = 0.01
-[contact.normal]
-law = "compliance"
-c = 100.0
-[time]
-T = 1.0
-steps = 4
-"""
 
 
 def base():
-    return tomllib.loads(BASE)
+    """A 2 × 1 block of 4 × 2 cells pressed by a traction onto a compliant wall."""
+    return scene_dict({
+        "mesh.size": [2.0, 1.0], "mesh.cells": [4, 2], "boundary.dirichlet": ["left"],
+        "material.nu": 0.25, "loads.traction.top": ["0", "-t"], "contact.gap": 0.01,
+        "contact.normal": law("compliance", c=100.0), "time.steps": 4})
 
 
 def test_defaults_and_lame_pair():
@@ -50,6 +33,56 @@ def test_defaults_and_lame_pair():
     assert scene.resolved["time"] == {"T": 1.0, "steps": 4, "k": 0.25}
 
 
+def test_resolved_record_lists_every_table_with_its_defaults():
+    assert scene_from_dict(base()).resolved == {
+        "title": "untitled", "dim": 2,
+        "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [4, 2],
+                 "pattern": "diagonal", "refine": 0},
+        "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
+        "material": {"E": 1000.0, "nu": 0.25, "lam": 400.0,
+                     "mu": 400.0},
+        "memory": None,
+        "loads": {"body": ["0", "0"], "traction": {"top": ["0", "-t"]}},
+        "contact": {"gap": 0.01, "quadrature": "nodal", "order": 4,
+                    "normal": {"law": "compliance", "c": 100.0}, "friction": [],
+                    "bonding": {"law": "none"}},
+        "time": {"T": 1.0, "steps": 4, "k": 0.25},
+        "solver": {"method": "newton", "tol": 1e-10, "max_iter": 50},
+        "output": {"probes": []},
+        "exact": None,
+    }
+
+
+def test_resolved_record_keeps_what_the_scene_gave():
+    # numbers stay numbers (gap, beta0) or their text (loads); the material
+    # pair given is kept; a bonding table records the integrator
+    data = base()
+    data["material"] = {"lam": 3.0, "mu": 2.0}
+    data["memory"] = {"kernel": "function", "r": 2, "E": 1.0, "nu": 0.2}
+    data["loads"] = {"body": [0, -1.5]}
+    data["contact"]["gap"] = "0.01 + x"
+    data["contact"]["bonding"] = {"law": "none", "beta0": 1}
+    resolved = scene_from_dict(data).resolved
+    assert resolved["material"] == {"lam": 3.0, "mu": 2.0}
+    assert resolved["memory"] == {"kernel": "function", "r": "2", "E": 1.0, "nu": 0.2}
+    assert resolved["loads"] == {"body": ["0", "-1.5"], "traction": {}}
+    contact = resolved["contact"]
+    assert contact["gap"] == "0.01 + x"
+    assert contact["beta0"] == 1 and type(contact["beta0"]) is int
+    assert contact["integrator"] == "explicit" and contact["bonding"] == {"law": "none"}
+
+
+def test_resolved_record_follows_a_replaced_discretisation():
+    # the record is derived from the dataclasses: nothing to patch
+    scene = scene_from_dict(base())
+    finer = replace(scene, mesh=replace(scene.mesh, refine=2), steps=16)
+    assert finer.resolved["mesh"]["refine"] == 2
+    assert finer.resolved["time"] == {"T": 1.0, "steps": 16, "k": 0.0625}
+    assert scene.resolved["mesh"]["refine"] == 0
+    other = {**finer.resolved, "mesh": scene.resolved["mesh"], "time": scene.resolved["time"]}
+    assert other == scene.resolved
+
+
 def test_lame_input_is_taken_as_is():
     data = base()
     data["material"] = {"lam": 3.0, "mu": 2.0}
@@ -62,22 +95,9 @@ def test_shipped_default_scene_is_the_studies_copy():
         (ROOT / "studies" / "scenes" / "default.toml").read_text()
 
 
-def _set(data, path, value):
-    *head, last = path
-    for key in head:
-        data = data[key]
-    if value is _DELETE:
-        del data[last]
-    else:
-        data[last] = value
-
-
-_DELETE = object()
-
-
 @pytest.mark.parametrize("path, value, message", [
     (("mesh", "sise"), [1, 1], "mesh.sise: unknown key"),
-    (("material", "E"), _DELETE, "material.E: missing; a number is required"),
+    (("material", "E"), DELETE, "material.E: missing; a number is required"),
     (("material", "lam"), 1.0, "material.E: give exactly one pair"),
     (("time", "steps"), "ten", "time.steps: must be an integer"),
     (("time", "steps"), 0, "time.steps: must be an integer >= 1"),
@@ -104,13 +124,36 @@ _DELETE = object()
     (("dim",), 4, "dim: must be 2 (plane strain) or 3"),
 ])
 def test_bad_input_names_the_key(path, value, message):
-    data = base()
-    _set(data, path, value)
+    data = scene_dict({".".join(path): value}, base())
     with pytest.raises(SceneError) as err:
         scene_from_dict(data)
     text = str(err.value)
     assert message in text
     assert "\n" not in text
+
+
+def test_gauss_quadrature_takes_only_the_laws_without_a_kink():
+    data = base()
+    data["contact"]["quadrature"] = "gauss"
+    data["contact"]["friction"] = [{"law": "power", "mu": 1.0, "q": 0.5},
+                                   {"law": "tresca", "mu": 1.0}]
+    with pytest.raises(SceneError) as err:
+        scene_from_dict(data)
+    assert str(err.value) == ("contact.quadrature: 'gauss' takes smooth friction laws only "
+                              "(power, adhesive_spring); 'tresca' needs 'nodal'")
+    data["contact"]["friction"] = [{"law": "power", "mu": 1.0, "q": 0.5},
+                                   {"law": "adhesive_spring", "gamma": 1.0, "L": 0.1}]
+    assert scene_from_dict(data).contact.quadrature == "gauss"
+
+
+def test_a_scene_document_written_as_toml_reads_back():
+    # the tests' TOML writer: what the command-line tests give adhcontact
+    data = scene_dict({"memory": {"kernel": "prony", "terms": [{"E": 1.0, "nu": 0.2, "tau": 2}]},
+                       "contact.friction": [law("tresca", mu=1.0), law("power", mu=1.0, q=1)],
+                       "output.probes": [[1.0, 0.5]], "title": 'a "quoted" title'}, base())
+    text = to_toml(data)
+    assert tomllib.loads(text) == data
+    assert parse_scene(text).resolved == scene_from_dict(data).resolved
 
 
 def test_invalid_toml_is_a_scene_error():

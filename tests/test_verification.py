@@ -6,9 +6,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import law, scene_dict
 from skfem import Basis, ElementTriP1
 
-from adhesive_contact import build_problem, parse_scene
+from adhesive_contact import build_problem, parse_scene, scene_from_dict
 from adhesive_contact.assembly import stiffness_basis, strain_map
 from adhesive_contact.convergence import rates, run_level, run_reference
 from adhesive_contact.verification import (
@@ -114,50 +115,19 @@ def test_bonding_source_closes_the_ode(case):
 # ---------------------------------------------------------------- exactness
 
 
-EXACT_IN_SPACE_AND_TIME = """
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [1.0, 1.0]
-cells = [3, 2]
-pattern = "cross"
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-[material]
-E = 1000.0
-nu = 0.3
-[contact.normal]
-law = "adhesive_compliance"
-c = 10000.0
-gamma = 5000.0
-L = 0.02
-[[contact.friction]]
-law = "tresca"
-mu = 1.0
-[[contact.friction]]
-law = "adhesive_spring"
-gamma = 500.0
-L = 0.02
-[contact.bonding]
-law = "fremond"
-gamma_nu = 300.0
-gamma_tau = 100.0
-eps_a = 0.0
-L = 0.02
-[exact]
-# linear in space (P1 reproduces it) and β* constant: without memory the
-# scheme is exact at every t_n, whatever the time dependence
-u = ["0.01*(1 - y)*sin(3*t)", "0.008*(1 - y)*(1 + t*t)"]
-beta = "0.7"
-[time]
-T = 1.0
-steps = 5
-"""
+EXACT_IN_SPACE_AND_TIME = scene_dict({
+    "mesh": {"domain": "rectangle", "size": [1.0, 1.0], "cells": [3, 2], "pattern": "cross"},
+    "contact.normal": law("adhesive_compliance", c=10000.0, gamma=5000.0, L=0.02),
+    "contact.friction": [law("tresca", mu=1.0), law("adhesive_spring", gamma=500.0, L=0.02)],
+    "contact.bonding": law("fremond", gamma_nu=300.0, gamma_tau=100.0, eps_a=0.0, L=0.02),
+    # linear in space (P1 reproduces it) and β* constant: without memory the
+    # scheme is exact at every t_n, whatever the time dependence
+    "exact": {"u": ["0.01*(1 - y)*sin(3*t)", "0.008*(1 - y)*(1 + t*t)"], "beta": "0.7"},
+    "time.steps": 5})
 
 
 def test_a_field_the_scheme_represents_exactly_has_round_off_errors():
-    scene = parse_scene(EXACT_IN_SPACE_AND_TIME)
+    scene = scene_from_dict(EXACT_IN_SPACE_AND_TIME)
     record = run_level(scene, "h", 0)
     # errors against |ε(u*)| ≈ 1e-2 and β* = 0.7: round-off, not discretisation
     assert record["err_u"] < 1e-12 and record["err_beta"] < 1e-12
@@ -171,7 +141,7 @@ def test_prolongation_is_exact_on_nested_meshes(pattern):
     """P carries a coarse P1 field to the fine mesh exactly: at every fine
     vertex it equals the coarse interpolant (checked by skfem's probes), and
     the fine strain integral equals the coarse one."""
-    spec = parse_scene(EXACT_IN_SPACE_AND_TIME.replace('"cross"', f'"{pattern}"')).mesh
+    spec = scene_from_dict(scene_dict({"mesh.pattern": pattern}, EXACT_IN_SPACE_AND_TIME)).mesh
     meshes = nested_meshes(spec, 2)
     P = prolongation(meshes)
     coarse, fine = meshes[0], meshes[-1]
@@ -186,7 +156,7 @@ def test_prolongation_is_exact_on_nested_meshes(pattern):
 
 
 def test_facet_parents_contain_their_children():
-    mesh_spec = parse_scene(EXACT_IN_SPACE_AND_TIME).mesh
+    mesh_spec = scene_from_dict(EXACT_IN_SPACE_AND_TIME).mesh
     meshes = nested_meshes(mesh_spec, 2)
     coarse, fine = meshes[0], meshes[-1]
     cf, ff = coarse.boundaries["bottom"], fine.boundaries["bottom"]
