@@ -16,7 +16,6 @@ Everything here is pure computation: the caller stores the level records
 (and the reference) and decides what to recompute.
 """
 
-import copy
 import time
 from dataclasses import dataclass, replace
 

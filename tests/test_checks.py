@@ -8,7 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from adhesive_contact import build_problem, parse_scene, solve
+from conftest import scene_dict
+
+from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
 from adhesive_contact.convergence import with_discretisation
 from adhesive_contact.scheme import STEP_FAILED, InvalidState
 from adhesive_contact.scheme.checks import check_level
@@ -64,25 +66,9 @@ def test_within_the_bound_the_same_scene_runs():
 
 def test_non_finite_load_stops_at_step_zero():
     # no contact boundary: before, a load 0/0 gave exit 0 and an all-NaN u
-    text = """
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [1.0, 1.0]
-cells = [4, 4]
-[boundary]
-dirichlet = ["left"]
-contact = []
-[material]
-E = 1.0
-nu = 0.3
-[loads]
-body = ["0/0", "0"]
-[time]
-T = 1.0
-steps = 2
-"""
-    sol = solve(build_problem(parse_scene(text)))
+    scene = scene_dict({"boundary": {"dirichlet": ["left"], "contact": []},
+                        "loads.body": ["0/0", "0"], "time.steps": 2})
+    sol = solve(build_problem(scene_from_dict(scene)))
     assert isinstance(sol.failure, InvalidState) and sol.failure.n == 0
     assert "the load (body force" in str(sol.failure) and sol.t.size == 0
 
