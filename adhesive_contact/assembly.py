@@ -21,7 +21,6 @@ from skfem import (
     ElementTriP1,
     ElementVector,
     FacetBasis,
-    asm,
 )
 from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature

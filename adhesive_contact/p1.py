@@ -19,8 +19,8 @@ from math import factorial
 
 import numpy as np
 import scipy.sparse as sp
-from skfem.refdom import RefTet, RefTri
 from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTet, RefTri
 
 
 def gradients(mesh):

@@ -22,8 +22,8 @@ from pathlib import Path
 import click
 
 from adhesive_contact import solve
-from adhesive_contact.scheme import STOPPED
 from adhesive_contact.postprocess import beta_mean
+from adhesive_contact.scheme import STOPPED
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .converge import converge

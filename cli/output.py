@@ -25,9 +25,9 @@ from pathlib import Path
 
 import meshio
 import numpy as np
-from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 
 from adhesive_contact.postprocess import stress_3x3, von_mises
+from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 
 from . import plots

@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import scene_dict
 
 from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve

@@ -12,31 +12,19 @@ import time
 import numpy as np
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
+from conftest import law, scene_dict, to_toml
 
 # a small block pushed onto a compliant foundation: a few ms per step, so
 # 4000 steps run for many seconds unless interrupted
-SCENE = """
-title = "long run"
-dim = 2
-[mesh]
-domain = "rectangle"
-size = [1.0, 0.5]
-cells = [4, 2]
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-[material]
-E = 100.0
-nu = 0.3
-[loads]
-body = ["0", "-10*t"]
-[contact.normal]
-law = "compliance"
-c = 1000.0
-[time]
-T = 1.0
-steps = 4000
-"""
+SCENE_DICT = scene_dict({
+    "title": "long run",
+    "mesh": {"domain": "rectangle", "size": [1.0, 0.5], "cells": [4, 2]},
+    "material.E": 100.0,
+    "loads": {"body": ["0", "-10*t"]},
+    "contact": {"normal": law("compliance", c=1000.0)},
+    "time.steps": 4000,
+})
+SCENE = to_toml(SCENE_DICT)
 
 
 def test_ctrl_c_stops_at_the_end_of_a_step_and_keeps_the_levels_done(tmp_path):
@@ -72,7 +60,8 @@ def test_ctrl_c_stops_at_the_end_of_a_step_and_keeps_the_levels_done(tmp_path):
 
 
 def test_failure_at_the_first_level_writes_nothing(tmp_path):
-    (tmp_path / "scene.toml").write_text(SCENE.replace('"-10*t"', '"0/0"'))
+    (tmp_path / "scene.toml").write_text(
+        to_toml(scene_dict({"loads.body": ["0", "0/0"]}, SCENE_DICT)))
     result = CliRunner().invoke(main, ["solve", str(tmp_path / "scene.toml"),
                                        "--out", str(tmp_path / "out")])
     assert result.exit_code == 1

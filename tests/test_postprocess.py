@@ -11,8 +11,9 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import law, prony, scene_dict
 
-from adhesive_contact import build_problem, parse_scene, solve
+from adhesive_contact import build_problem, scene_from_dict, solve
 from adhesive_contact.postprocess import (
     beta_mean,
     cell_von_mises,
@@ -30,50 +31,20 @@ from adhesive_contact.storage import plain, read_json, write_atomic, write_json
 
 # a block hanging from its top, pulled down and sideways onto a compliant
 # layer with Tresca friction and a wall: normal and tangential forces
-SCENE = """\
-title = "block sheared on a compliant layer"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [1.0, 0.5]
-cells = [8, 4]
-
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[loads]
-body = ["200*t", "-800*t"]
-
-[contact]
-gap = "0.002 + 0.01*(x - 0.5)**2"
-
-[contact.normal]
-law = "compliance"
-c = 3000.0
-
-[[contact.friction]]
-law = "tresca"
-mu = 0.5
-
-[time]
-T = 1.0
-steps = 4
-"""
+SCENE = scene_dict({
+    "title": "block sheared on a compliant layer",
+    "mesh": {"domain": "rectangle", "size": [1.0, 0.5], "cells": [8, 4]},
+    "memory": prony((200.0, 0.3, 0.5)),
+    "loads": {"body": ["200*t", "-800*t"]},
+    "contact": {"gap": "0.002 + 0.01*(x - 0.5)**2", "normal": law("compliance", c=3000.0),
+                "friction": [law("tresca", mu=0.5)]},
+    "time.steps": 4,
+})
 
 
 @pytest.fixture(scope="module")
 def solution():
-    return solve(build_problem(parse_scene(SCENE)))
+    return solve(build_problem(scene_from_dict(SCENE)))
 
 
 # ---------------------------------------------------------------- stress

@@ -7,6 +7,7 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from types import SimpleNamespace
 
 import pytest
+from conftest import to_toml
 
 import adhesive_contact.studies.convergence as convergence_study
 from adhesive_contact import StepFailure
@@ -149,29 +150,14 @@ def test_any_executor_with_submit_and_as_completed(tmp_path, calls):
 
 # ---------------------------------------------------------------- convergence from Python
 
-EXACT_SCENE = """\
-title = "manufactured, no contact"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [1.0, 0.5]
-cells = [4, 2]
-
-[boundary]
-dirichlet = ["left"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[time]
-T = 1.0
-steps = 4
-
-[exact]
-u = ["0.01*x*x*(1+t)", "0.005*x*y"]
-"""
+EXACT_SCENE = to_toml({
+    "title": "manufactured, no contact", "dim": 2,
+    "mesh": {"domain": "rectangle", "size": [1.0, 0.5], "cells": [4, 2]},
+    "boundary": {"dirichlet": ["left"]},
+    "material": {"E": 1000.0, "nu": 0.3},
+    "time": {"T": 1.0, "steps": 4},
+    "exact": {"u": ["0.01*x*x*(1+t)", "0.005*x*y"]},
+})
 
 
 def test_convergence_study_from_python(tmp_path, monkeypatch, capsys):

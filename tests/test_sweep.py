@@ -5,56 +5,35 @@ runs, failed runs as rows, runs.csv against direct solves, resume."""
 import csv
 import inspect
 import shutil
-import tomllib
 
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
+from conftest import law, prony, scene_dict, to_toml
 
 import adhesive_contact.studies.sweep as sweep_module
-from adhesive_contact import StepFailure, build_problem, parse_scene, scene_from_dict, solve
+from adhesive_contact import (
+    StepFailure,
+    build_problem,
+    scene_from_dict,
+    solve,
+)
 from adhesive_contact.postprocess import beta_mean
 from adhesive_contact.studies import StudyError, Sweep, parse_assignment
 from adhesive_contact.studies.sweep import split_values, variants, with_value
 
 # an 8x4 block hanging from its top, pulled down onto a wall: with one
 # Newton iteration allowed, the stiff layer (c = 5000) fails at step 1
-SCENE = """\
-title = "test block"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [8, 4]
-
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[loads]
-body = ["0", "-400*t"]
-
-[contact]
-gap = "0.002 + 0.01*(x - 1)**2"
-
-[contact.normal]
-law = "compliance"
-c = 5000.0
-
-[time]
-T = 1.0
-steps = 3
-"""
+SCENE_DICT = scene_dict({
+    "title": "test block",
+    "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [8, 4]},
+    "memory": prony((200.0, 0.3, 0.5)),
+    "loads": {"body": ["0", "-400*t"]},
+    "contact": {"gap": "0.002 + 0.01*(x - 1)**2", "normal": law("compliance", c=5000.0)},
+    "time.steps": 3,
+})
+SCENE = to_toml(SCENE_DICT)
 
 GRID = ("--set", "contact.normal.c=1e3,5000", "--set", "solver.max_iter=1,50")
 
@@ -167,7 +146,7 @@ def test_grid_sweep_rows_match_direct_solves_and_failures_are_rows(grid_sweep):
     rows = read_rows(out / "runs.csv")
     assert [(r["contact.normal.c"], r["solver.max_iter"]) for r in rows] == [
         ("1000.0", "1"), ("1000.0", "50"), ("5000", "1"), ("5000", "50")]
-    base = tomllib.loads(SCENE)
+    base = SCENE_DICT
     for row in rows:
         doc = with_value(with_value(base, "contact.normal.c", float(row["contact.normal.c"])),
                          "solver.max_iter", int(row["solver.max_iter"]))
@@ -236,8 +215,8 @@ def test_zip_sweep_in_two_processes(scene_file, tmp_path):
     assert [(r["time.steps"], r["contact.normal.c"]) for r in rows] == [
         ("2", "1000.0"), ("4", "2000.0")]
     assert [r["outcome"] for r in rows] == ["ok", "ok"]
-    direct = solve(build_problem(parse_scene(
-        SCENE.replace("steps = 3", "steps = 4").replace("c = 5000.0", "c = 2000.0"))))
+    direct = solve(build_problem(scene_from_dict(scene_dict(
+        {"time.steps": 4, "contact.normal.c": 2000.0}, SCENE_DICT))))
     assert float(rows[1]["normal_force_T"]) == pytest.approx(
         -direct.contact_force[-1, :, 0].sum(), rel=1e-12)
     assert int(rows[1]["newton_total"]) == direct.iterations.sum()

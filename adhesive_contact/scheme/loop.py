@@ -13,7 +13,14 @@ from .checks import check_level, check_load
 from .operators import StepOperators
 from .recorder import HistoryRecorder
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
-from .state import ContactStep, State, bonding_step, initial_state, step_load, step_solve
+from .state import (
+    ContactStep,
+    State,
+    bonding_step,
+    initial_state,
+    step_load,
+    step_solve,
+)
 
 
 def solve(problem, progress=None, raise_on_failure=False, recorder=None):
