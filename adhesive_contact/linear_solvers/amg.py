@@ -84,7 +84,7 @@ class AMGSolver(LinearSolver):
         if not tol > 0:
             raise ValueError(f"tol must be positive, got {tol}")
         self.B, self.tol, self.maxiter = B, float(tol), int(maxiter)
-        self.options = {"max_coarse": 500, **options}
+        self.options = {"max_coarse": 100, **options}
         self.ml = None
         super().__init__(A)
 
