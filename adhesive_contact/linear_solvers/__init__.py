@@ -34,11 +34,13 @@ METHODS = ("auto", "pardiso", "superlu", "amg")
 # matrices of the unit square and cube clamped on one side, 1.9e3–2.6e5
 # dofs in 2D and 1.9e3–8.6e4 in 3D, and rounded up:
 # PARDISO c = 0.31–0.42 (2D), 0.38–0.51 (3D, rising slowly with n);
-# SuperLU (L and U) c = 0.55–0.93 (2D), 0.079–0.082 (3D, p = 2/3).
+# SuperLU (L and U) c = 0.55–1.01 (2D), 0.079–0.082 (3D, p = 2/3).
+# studies/bench/linear_backends.py measures factors and memory at 1e4–2.6e5
+# dofs: the estimates were 0.7–1.4× the measured peak memory of the solver.
 FILL = {
     ("pardiso", 2): (0.45, None),
     ("pardiso", 3): (0.6, 1 / 3),
-    ("superlu", 2): (1.0, None),
+    ("superlu", 2): (1.1, None),
     ("superlu", 3): (0.085, 2 / 3),
 }
 # an 8-byte value and a 4-byte index per factor entry (PARDISO's own peak

@@ -4,7 +4,9 @@ For elasticity the near-nullspace handed to the aggregation is the space of
 rigid body motions r(x) = a + W x (W skew): two translations and one
 rotation in 2D, three and three in 3D. With it the tentative prolongator
 reproduces them exactly on every level, and CG needs a number of
-iterations that grows slowly with the mesh (18–29 for 2e4–1e5 dofs in 2D).
+iterations that grows slowly with the mesh: for a relative residual of
+1e-10, 18, 29 and 36 for 1e4, 1e5 and 2.6e5 dofs in 2D, 21–25 for 9e3–9e4
+dofs in 3D (unit square and cube clamped on one side).
 """
 
 import numpy as np

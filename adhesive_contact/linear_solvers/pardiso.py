@@ -3,14 +3,16 @@
 pypardiso (and the MKL it loads) is imported only when a solver is built or
 :func:`available` is asked, so the package works where it is not installed.
 
-Settings, measured on P1 elasticity step matrices (2D and 3D, 1e4–9e4 dofs):
+Settings, measured on P1 elasticity step matrices (2e4 and 1e5 dofs in 2D,
+9e3 and 4e4 in 3D, one thread):
 
 - matrix type 2 (real SPD: Cholesky A = L Lᵀ on the upper triangle) instead
-  of pypardiso's default 11 (real nonsymmetric LU): half the factor entries
-  and 1.2–1.9× faster factorisations, residuals of the same 1e-14–1e-13.
+  of pypardiso's default 11 (real nonsymmetric LU): 0.55× the factor
+  entries and 1.3–1.8× faster factorisations, residuals alike (1e-14–1e-13).
 - no iterative refinement (iparm 8 = 0; MKL's default performs two steps per
   solve): a Cholesky solve is backward stable, and the refinement made every
-  solve 2–2.5× slower for a relative residual of 2e-13 instead of 3e-13.
+  solve 2–2.5× slower for relative residuals of 1.7e-13 (2D) and 9e-15 (3D)
+  instead of 3e-13 and 3e-14.
 - parallel nested dissection (iparm 2 = 3, MKL's default ordering).
 
 pypardiso keeps a copy of the matrix it factorised (of nnz(A) ≤ 5e7, else a
