@@ -36,7 +36,8 @@ METHODS = ("auto", "pardiso", "superlu", "amg")
 # PARDISO c = 0.31–0.42 (2D), 0.38–0.51 (3D, rising slowly with n);
 # SuperLU (L and U) c = 0.55–1.01 (2D), 0.079–0.082 (3D, p = 2/3).
 # studies/bench/linear_backends.py measures factors and memory at 1e4–2.6e5
-# dofs: the estimates were 0.7–1.4× the measured peak memory of the solver.
+# dofs: the estimates were 0.6–1.4× the measured peak memory of the solver
+# (PARDISO in 2D takes 18–25 bytes per entry of L with its work arrays).
 FILL = {
     ("pardiso", 2): (0.45, None),
     ("pardiso", 3): (0.6, 1 / 3),
