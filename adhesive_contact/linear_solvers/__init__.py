@@ -1,0 +1,149 @@
+"""Linear solvers for the SPD step matrices, behind one interface.
+
+    solver = make_linear_solver(A, "auto", dim=2, points=mesh.p, dofs=free)
+    x = solver.solve(b)
+
+Backends (:mod:`.base` states the interface):
+
+- ``"pardiso"``: MKL PARDISO sparse Cholesky (:mod:`.pardiso`), where
+  pypardiso and MKL are installed;
+- ``"superlu"``: SciPy's SuperLU (:mod:`.superlu`), always there;
+- ``"amg"``: CG preconditioned by smoothed aggregation AMG with the rigid
+  body modes (:mod:`.amg`), for matrices whose factors would not fit.
+
+``"auto"`` (:func:`choose`) takes PARDISO where it is available, else
+SuperLU, unless the estimated memory of that factorisation
+(:func:`factor_bytes`) exceeds the memory limit: then AMG.
+"""
+
+import os
+
+import numpy as np
+
+from . import pardiso
+from .amg import AMGSolver, rigid_body_modes
+from .base import LinearSolver, LinearSolverError
+from .pardiso import PardisoSolver
+from .superlu import SuperLUSolver
+
+METHODS = ("auto", "pardiso", "superlu", "amg")
+
+# nnz(factors)/nnz(A) = c·log2(n) in 2D, c·n^p in 3D (nested dissection
+# gives n log n and n^(4/3) factor entries in 2D and 3D; SuperLU's minimum
+# degree ordering about n^(5/3) in 3D). Fitted to P1 elasticity step
+# matrices of the unit square and cube clamped on one side, 1.9e3–2.6e5
+# dofs in 2D and 1.9e3–8.6e4 in 3D, and rounded up:
+# PARDISO c = 0.31–0.42 (2D), 0.38–0.51 (3D, rising slowly with n);
+# SuperLU (L and U) c = 0.55–1.01 (2D), 0.079–0.082 (3D, p = 2/3).
+# studies/bench/linear_backends.py measures factors and memory at 1e4–2.6e5
+# dofs: the estimates were 0.6–1.4× the measured peak memory of the solver
+# (PARDISO in 2D takes 18–25 bytes per entry of L with its work arrays).
+FILL = {
+    ("pardiso", 2): (0.45, None),
+    ("pardiso", 3): (0.6, 1 / 3),
+    ("superlu", 2): (1.1, None),
+    ("superlu", 3): (0.085, 2 / 3),
+}
+# an 8-byte value and a 4-byte index per factor entry (PARDISO's own peak
+# was 9.3–14.6 bytes per entry of L from 1e4 dofs on)
+BYTES_PER_ENTRY = 12
+MEMORY_FRACTION = 0.5   # of physical memory, the default limit
+
+
+def factor_bytes(n, nnz, dim, method):
+    """Estimated memory of the factors of an n × n P1 elasticity matrix
+    with nnz entries: BYTES_PER_ENTRY · nnz · c·log2(n) (2D) or c·n^p (3D)."""
+    c, p = FILL[(method, dim)]
+    growth = np.log2(max(n, 2)) if p is None else max(n, 1) ** p
+    return float(BYTES_PER_ENTRY * nnz * c * growth)
+
+
+def default_memory_limit():
+    """MEMORY_FRACTION of the physical memory (4 GiB if it cannot be read)."""
+    try:
+        physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return 4 * 2**30
+    return MEMORY_FRACTION * physical
+
+
+def _gb(nbytes):
+    return f"{nbytes / 1e9:.3g} GB"
+
+
+def choose(n, nnz, dim, memory_limit=None):
+    """The backend for ``method = "auto"`` and one sentence saying why.
+
+    Parameters
+    ----------
+    n, nnz : int
+        Size and number of stored entries of the matrix.
+    dim : 2 or 3
+    memory_limit : float, optional
+        Bytes the factors may take (default: :func:`default_memory_limit`).
+
+    Returns
+    -------
+    (name, reason) : (str, str)
+    """
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    limit = default_memory_limit() if memory_limit is None else float(memory_limit)
+    if pardiso.available():
+        direct, label, why = "pardiso", "PARDISO", "MKL PARDISO is available"
+    else:
+        direct, label, why = "superlu", "SuperLU", "PARDISO is not available here (no pypardiso or MKL)"
+    need = factor_bytes(n, nnz, dim, direct)
+    if need > limit:
+        return "amg", (f"{label}'s factors of the {n}-dof matrix would take about {_gb(need)}, "
+                       f"more than the {_gb(limit)} limit, so AMG-preconditioned CG is used.")
+    return direct, (f"{why} and {label}'s factors of the {n}-dof matrix take about {_gb(need)}, "
+                    f"within the {_gb(limit)} limit.")
+
+
+def make_linear_solver(A, method="auto", *, dim, points=None, dofs=None, tol=1e-10,
+                       memory_limit=None):
+    """A solver of A x = b by the named backend, or the one :func:`choose` picks.
+
+    Parameters
+    ----------
+    A : sparse SPD (n, n)
+    method : one of METHODS
+    dim : 2 or 3
+    points, dofs : the mesh nodes (dim, npoints) and the free dofs of A in
+        the interleaved numbering dof = dim·node + c: needed for AMG (its
+        near-nullspace, :func:`rigid_body_modes`).
+    tol : float
+        Relative residual of the AMG-preconditioned CG.
+    memory_limit : float, optional
+        Bytes the factors may take, for ``"auto"``.
+
+    Returns
+    -------
+    LinearSolver, with ``reason`` saying why it was chosen.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method {method!r}: allowed are {', '.join(METHODS)}")
+    if method == "auto":
+        method, reason = choose(A.shape[0], A.nnz, dim, memory_limit)
+    else:
+        reason = f"method {method!r} was asked for."
+    if method == "pardiso" and not pardiso.available():
+        raise ValueError("method 'pardiso': pypardiso or MKL is not installed here; "
+                         "allowed are auto, superlu, amg")
+    if method == "amg":
+        if points is None or dofs is None:
+            raise ValueError("method 'amg' needs the mesh points and the free dofs "
+                             "(its near-nullspace is the rigid body modes)")
+        if np.shape(points)[0] != dim:
+            raise ValueError(f"points must have shape ({dim}, npoints), got {np.shape(points)}")
+        solver = AMGSolver(A, B=rigid_body_modes(points, dofs), tol=tol)
+    else:
+        solver = {"pardiso": PardisoSolver, "superlu": SuperLUSolver}[method](A)
+    solver.reason = reason
+    return solver
+
+
+__all__ = ["METHODS", "AMGSolver", "LinearSolver", "LinearSolverError", "PardisoSolver",
+           "SuperLUSolver", "choose", "default_memory_limit", "factor_bytes",
+           "make_linear_solver", "rigid_body_modes"]

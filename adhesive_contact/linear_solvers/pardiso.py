@@ -1,0 +1,120 @@
+"""Sparse Cholesky of MKL PARDISO, through pypardiso.
+
+pypardiso (and the MKL it loads) is imported only when a solver is built or
+:func:`available` is asked, so the package works where it is not installed.
+
+Settings, measured on P1 elasticity step matrices (2e4 and 1e5 dofs in 2D,
+9e3 and 4e4 in 3D, one thread):
+
+- matrix type 2 (real SPD: Cholesky A = L Lᵀ on the upper triangle) instead
+  of pypardiso's default 11 (real nonsymmetric LU): 0.55× the factor
+  entries and 1.3–1.8× faster factorisations, residuals alike (1e-14–1e-13).
+- no iterative refinement (iparm 8 = 0; MKL's default performs two steps per
+  solve): a Cholesky solve is backward stable, and the refinement made every
+  solve 2–2.5× slower for relative residuals of 1.7e-13 (2D) and 9e-15 (3D)
+  instead of 3e-13 and 3e-14.
+- parallel nested dissection (iparm 2 = 3, MKL's default ordering).
+
+pypardiso keeps a copy of the matrix it factorised (of nnz(A) ≤ 5e7, else a
+hash of it) and compares it with the matrix of every ``solve``, an O(nnz(A))
+check against the O(nnz(L)) triangular solves; this class keeps the upper
+triangle it factorised and passes that same matrix. MKL keeps the factors
+in its own memory until the handle is released, which pypardiso never does
+on its own (each forgotten factorisation stays): a finaliser releases it
+when the solver is garbage-collected.
+
+MKL runs on as many threads as ``threadpoolctl`` allows the ``blas`` API
+(MKL's default: one per core).
+"""
+
+import functools
+import os
+import weakref
+
+import scipy.sparse as sp
+
+from .base import LinearSolver, LinearSolverError
+
+SPD = 2   # PARDISO matrix type: real symmetric positive definite
+
+
+@functools.cache
+def mkl_runtime():
+    """The MKL runtime library pypardiso loads, or None if it cannot."""
+    try:
+        from pypardiso import PyPardisoSolver
+        return PyPardisoSolver().libmkl._name
+    except (ImportError, OSError):
+        return None
+
+
+def available():
+    """True if pypardiso imports and finds MKL's runtime library here."""
+    return mkl_runtime() is not None
+
+
+def _new_handle():
+    """A PARDISO handle for an SPD matrix. pypardiso looks for MKL's runtime
+    on every construction, by a recursive search of the environment when
+    ``ctypes.util.find_library`` does not find it (0.1–0.3 s each time
+    here); it takes the path from PYPARDISO_MKL_RT instead when that is set,
+    which is done once (a user's own setting is kept)."""
+    from pypardiso import PyPardisoSolver
+
+    if mkl_runtime() is not None:
+        os.environ.setdefault("PYPARDISO_MKL_RT", mkl_runtime())
+    return PyPardisoSolver(mtype=SPD)
+
+
+def _release(pardiso):
+    """Free all of MKL's memory for this handle (phase −1)."""
+    pardiso.free_memory(everything=True)
+
+
+class PardisoSolver(LinearSolver):
+    """A = L Lᵀ by MKL PARDISO (matrix type 2, nested dissection ordering).
+
+    Attributes
+    ----------
+    pardiso : pypardiso.PyPardisoSolver or None
+        The handle of the factorisation (None for n = 0).
+    info : dict
+        ``factor_nnz`` (nonzeros of L, as PARDISO reports it),
+        ``memory_bytes`` (PARDISO's peak memory for the analysis and
+        factorisation), ``matrix_type``.
+    """
+
+    name = "pardiso"
+    exact = True
+
+    def __init__(self, A):
+        self.pardiso = None
+        super().__init__(A)
+
+    def _setup(self, A):
+        from pypardiso.pardiso_wrapper import PyPardisoError
+
+        self.upper = sp.triu(A, format="csr")
+        self.upper.sort_indices()
+        pardiso = _new_handle()
+        pardiso.set_iparm(1, 1)     # the iparm below, not MKL's defaults
+        pardiso.set_iparm(2, 3)     # parallel nested dissection ordering
+        pardiso.set_iparm(8, 0)     # no iterative refinement
+        pardiso.set_iparm(18, -1)   # report nnz(L)
+        weakref.finalize(self, _release, pardiso)
+        try:
+            pardiso.factorize(self.upper)
+        except PyPardisoError as err:
+            hint = " (−4: a zero or negative pivot, A is not SPD)" if err.value == -4 else ""
+            raise LinearSolverError(f"PARDISO factorisation of the {self.n}×{self.n} matrix "
+                                    f"failed with error {err.value}{hint}") from err
+        self.pardiso = pardiso
+        self.info = {
+            "factor_nnz": int(pardiso.get_iparm(18)),
+            "memory_bytes": 1024 * int(max(pardiso.get_iparm(15),
+                                           pardiso.get_iparm(16) + pardiso.get_iparm(17))),
+            "matrix_type": SPD,
+        }
+
+    def _solve(self, B):
+        return self.pardiso.solve(self.upper, B)
