@@ -47,14 +47,14 @@ def build(dim, cells, path):
     """Assemble the clamped stiffness and save (A, points, free) to path."""
     from skfem import MeshTet, MeshTri
 
-    from adhesive_contact.assembly import Assembly
+    from adhesive_contact.assembly import Assembly, stiffness_basis
     from adhesive_contact.mesh import side_tests
 
     axes = [np.linspace(0.0, 1.0, cells + 1)] * dim
     mesh = (MeshTri if dim == 2 else MeshTet).init_tensor(*axes).with_boundaries(
         side_tests([1.0] * dim))
     assembly = Assembly(mesh)
-    clamped = assembly.basis.get_dofs("left").flatten()
+    clamped = stiffness_basis(mesh).get_dofs("left").flatten()
     free = np.setdiff1d(np.arange(assembly.ndofs), clamped)
     A = assembly.stiffness(LAM, MU)[free][:, free].tocsr()
     np.savez(path, data=A.data, indices=A.indices, indptr=A.indptr, shape=A.shape,
