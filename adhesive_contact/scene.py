@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 from .expressions import ExpressionError, compile_expression
 from .laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
+from .linear_solvers import METHODS
+from .linear_solvers.pardiso import available as pardiso_available
 
 
 class SceneError(ValueError):
@@ -126,6 +128,7 @@ class SolverSpec:
     method: str = "newton"
     tol: float = 1e-10
     max_iter: int = 50
+    linear: str = "auto"          # the linear backend (adhesive_contact.linear_solvers)
 
 
 @dataclass(frozen=True)
@@ -179,7 +182,7 @@ class Scene:
             "contact": _contact_record(self.contact),
             "time": {"T": self.T, "steps": self.steps, "k": self.k},
             "solver": {"method": self.solver.method, "tol": self.solver.tol,
-                       "max_iter": self.solver.max_iter},
+                       "max_iter": self.solver.max_iter, "linear": self.solver.linear},
             "output": {"probes": [list(p) for p in self.probes]},
             "exact": _exact_record(self.exact),
         }
@@ -581,8 +584,12 @@ def _read_solver(table):
     max_iter = table.get("max_iter", "int", 50)
     if max_iter < 1:
         raise SceneError("solver.max_iter", f"must be an integer >= 1, got {max_iter}")
+    linear = _choice("solver.linear", table.get("linear", "str", "auto"), METHODS)
+    if linear == "pardiso" and not pardiso_available():
+        raise SceneError("solver.linear", "'pardiso' needs pypardiso and MKL, which are not "
+                         "installed here; allowed are auto, superlu, amg")
     table.finish()
-    return SolverSpec(method, tol, max_iter)
+    return SolverSpec(method, tol, max_iter, linear)
 
 
 def _read_probes(table, dim):

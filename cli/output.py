@@ -88,6 +88,7 @@ def summary(solution):
         "smallness": smallness_record(problem),
         "warnings": [str(w) for w in problem.warnings()],
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
+        "linear": dict(solution.linear),
         "iterations": [int(i) for i in solution.iterations],
         "steps": step_records(solution),
     }

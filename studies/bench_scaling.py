@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from adhesive_contact import build_problem, parse_scene, solve
-from adhesive_contact.linear import DirectSolver
+from adhesive_contact.linear_solvers import SuperLUSolver as DirectSolver
 
 HERE = Path(__file__).resolve().parent
 

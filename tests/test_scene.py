@@ -47,7 +47,7 @@ def test_resolved_record_lists_every_table_with_its_defaults():
                     "normal": {"law": "compliance", "c": 100.0}, "friction": [],
                     "bonding": {"law": "none"}},
         "time": {"T": 1.0, "steps": 4, "k": 0.25},
-        "solver": {"method": "newton", "tol": 1e-10, "max_iter": 50},
+        "solver": {"method": "newton", "tol": 1e-10, "max_iter": 50, "linear": "auto"},
         "output": {"probes": []},
         "exact": None,
     }

@@ -78,6 +78,12 @@ class LinearSolver:
         X = self._solve(np.asfortranarray(b.reshape(self.n, -1)))
         return X.reshape(b.shape)
 
+    def schur(self, A, interior, contact):
+        """The dense Schur complement S = A_CC − A_CI A_II⁻¹ A_IC of the
+        matrix A whose interior block A_II this solver holds, read off a
+        factorisation where the backend can (None: form it by solves)."""
+        return None
+
     def aslinearoperator(self):
         """A⁻¹ as a :class:`~scipy.sparse.linalg.LinearOperator`, usable as
         the preconditioner ``M`` of :func:`scipy.sparse.linalg.cg`."""

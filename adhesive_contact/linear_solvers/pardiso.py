@@ -31,6 +31,7 @@ import functools
 import os
 import weakref
 
+import numpy as np
 import scipy.sparse as sp
 
 from .base import LinearSolver, LinearSolverError
@@ -118,3 +119,37 @@ class PardisoSolver(LinearSolver):
 
     def _solve(self, B):
         return self.pardiso.solve(self.upper, B)
+
+    def schur(self, A, interior, contact):
+        """S by PARDISO's own Schur complement (iparm(36) = 1): a partial
+        factorisation of the whole A with the rows of C marked in ``perm``,
+        which returns S dense (about the cost of one factorisation; forming
+        S by block solves cost 10× more at 1e5 dofs). A separate handle, freed
+        at once; the factorisation of A_II for the step solves is kept."""
+        nC = contact.size
+        if nC == 0:
+            return None
+        from pypardiso.pardiso_wrapper import PyPardisoError
+
+        n = A.shape[0]
+        upper = sp.triu(sp.csr_matrix(A, dtype=float), format="csr")
+        upper.sort_indices()
+        pardiso = _new_handle()
+        pardiso.set_iparm(1, 1)
+        pardiso.set_iparm(2, 3)
+        pardiso.set_iparm(8, 0)
+        pardiso.set_iparm(36, 1)    # compute the Schur complement of the marked rows
+        pardiso.perm = np.zeros(n, dtype=np.int32)
+        pardiso.perm[contact] = 1
+        # x receives S (nC × nC, column-major) at phase 12: give it room
+        work = np.zeros((n, max(-(-nC * nC // n), 1)), order="F")
+        try:
+            pardiso._check_A(upper)
+            pardiso.set_phase(12)
+            x = pardiso._call_pardiso(upper, work)
+        except PyPardisoError as err:
+            raise LinearSolverError(f"PARDISO's Schur complement of the {n}×{n} matrix "
+                                    f"failed with error {err.value}") from err
+        finally:
+            _release(pardiso)
+        return np.asarray(x).ravel(order="F")[:nC * nC].reshape(nC, nC)

@@ -10,11 +10,12 @@ only, ½ zᵀ S z − cᵀ z + contact terms; then u_I = A_II⁻¹ (b_I − A_IC
 (The caller writes the system in the nodal frames of
 :mod:`adhesive_contact.contact_boundary`, so z are frame components.)
 
-A_II is factorised once per mesh and step size (a linear backend of
-:mod:`adhesive_contact.linear`), and S is read off a second factorisation
-with the contact unknowns ordered last (or, should SuperLU reorder them,
-formed by one solve per contact unknown); a step then costs two solves with
-the factors of A_II.
+A_II is factorised once per mesh and step size by a linear backend of
+:mod:`adhesive_contact.linear_solvers`. S is read off a factorisation of
+the whole matrix where the backend can (SuperLU: the trailing block with
+the contact unknowns ordered last; PARDISO: its own Schur complement),
+else formed by solves with blocks of the columns of A_IC (AMG). A step then
+costs two solves with A_II.
 
 S reaches the step solver as one of two operators with the same interface
 (``S @ z``, ``diagonal()``, ``newton_solve``): :class:`DenseSchur`, formed,
@@ -26,9 +27,9 @@ import time
 import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
-from scipy.sparse.linalg import LinearOperator, cg, splu
+from scipy.sparse.linalg import LinearOperator, cg
 
-from ..linear import DirectSolver
+from ..linear_solvers import SuperLUSolver
 
 
 def dense_solver(H):
@@ -105,6 +106,11 @@ class ImplicitSchur:
         return d, info == 0
 
 
+def superlu(A, rows):
+    """The default backend of :class:`CondensedOperator`."""
+    return SuperLUSolver(A)
+
+
 class CondensedOperator:
     """A step matrix on the free dofs, condensed onto the contact unknowns.
 
@@ -114,15 +120,18 @@ class CondensedOperator:
         The step matrix restricted to the free dofs.
     contact : (nC,) int
         Positions, within the free dofs, of the contact unknowns.
-    chunk : int
+    factorise : callable (A_II, interior) -> LinearSolver, ``interior`` the
+        positions of A_II's rows within the free dofs (default: SuperLU)
+    chunk : int, optional
         Right-hand sides per block solve when forming S (SuperLU's block
-        solve is fastest per column for a few columns at a time).
+        solve is fastest per column for a few columns at a time, 16; the
+        other backends take 64).
     approximation : dense (nC, nC), optional
         A nearby Schur complement: then S is not formed but applied
         (:class:`ImplicitSchur`), for an operator used for one step only.
     """
 
-    def __init__(self, A, contact, chunk=16, approximation=None):
+    def __init__(self, A, contact, factorise=None, chunk=None, approximation=None):
         t0 = time.perf_counter()
         n = A.shape[0]
         self.contact = np.asarray(contact, dtype=np.int64)
@@ -133,7 +142,8 @@ class CondensedOperator:
         A_II = A[self.interior][:, self.interior]
         self.A_IC = A[self.interior][:, self.contact].tocsc()
         self.A_CI = self.A_IC.T.tocsr()
-        self.solver = DirectSolver(A_II)   # the linear backend
+        self.solver = (factorise or superlu)(A_II, self.interior)   # the linear backend
+        chunk = chunk or (16 if self.solver.name == "superlu" else 64)
         self.factor_seconds = time.perf_counter() - t0
 
         t0 = time.perf_counter()
@@ -144,7 +154,7 @@ class CondensedOperator:
                                    self.A_IC, self.solver, approximation)
             self.schur_seconds = time.perf_counter() - t0
             return
-        S = self._schur_by_factorisation(A) if nC else None
+        S = self.solver.schur(A, self.interior, self.contact) if nC else None
         if S is None:   # one block solve per contact unknown
             S = A[self.contact][:, self.contact].toarray()
             for start in range(0, nC, chunk):
@@ -153,28 +163,6 @@ class CondensedOperator:
                 S[:, cols] -= self.A_CI @ X
         self.S = DenseSchur(0.5 * (S + S.T))
         self.schur_seconds = time.perf_counter() - t0
-
-    def _schur_by_factorisation(self, A):
-        """S as the trailing block of an LU factorisation with C ordered last.
-
-        With the interior in the fill-reducing order SuperLU chose for A_II
-        and the contact unknowns after it, factorised without reordering
-        (symmetric mode: diagonal pivots), A = L U and S = L_CC U_CC. That
-        costs about one more factorisation instead of one solve per contact
-        unknown. None if SuperLU moved a row or column of the C block.
-        """
-        if self.solver.lu is None:
-            return None
-        order = np.concatenate([self.interior[np.argsort(self.solver.lu.perm_c)], self.contact])
-        n, nC = order.size, self.contact.size
-        lu = splu(sp.csc_matrix(A[order][:, order]), permc_spec="NATURAL",
-                  options={"SymmetricMode": True, "DiagPivotThresh": 1e-3})
-        tail = np.arange(n - nC, n)
-        if not (np.array_equal(lu.perm_c[-nC:], tail) and np.array_equal(lu.perm_r[-nC:], tail)):
-            return None
-        L = lu.L.tocsc()[n - nC:, n - nC:].toarray()
-        U = lu.U.tocsc()[n - nC:, n - nC:].toarray()
-        return L @ U
 
     def reduce(self, b):
         """c = b_C − A_CI A_II⁻¹ b_I for a load b on the free dofs."""

@@ -79,4 +79,5 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
                STOPPED: f"stopped after step {state.n} (t = {state.t:g})"}[status]
     return Solution(problem=problem, status=status, message=message, failure=failure,
                     t=problem.times[:recorder.count].copy(), timings=timings,
+                    linear=operators.linear,
                     **recorder.history())

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..linear_solvers import make_linear_solver
 from .condensed import CondensedOperator
 
 
@@ -31,6 +32,12 @@ class StepOperators:
     factor_seconds: float
     schur_seconds: float
 
+    @property
+    def linear(self):
+        """The linear backend of the run and why: {"method", "reason"}."""
+        solver = self.step.solver
+        return {"method": solver.name, "reason": solver.reason}
+
     @classmethod
     def build(cls, problem, memory):
         """Factorise and condense the step matrices of ``problem`` with the
@@ -38,13 +45,20 @@ class StepOperators:
         t0 = time.perf_counter()
         assembly, free = problem.assembly, problem.free
         R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
+        method = problem.scene.solver.linear
+
+        def factorise(A_II, interior):
+            # the rigid body modes of AMG in Cartesian components (the few
+            # rotated dofs at Γ_C only weaken its near-nullspace there)
+            return make_linear_solver(A_II, method, dim=problem.dim, points=problem.mesh.p,
+                                      dofs=free[interior])
 
         def condensed(lam, mu, approximation=None):
             A = assembly.stiffness(lam, mu)
             if R is not None:
                 A = (R.T @ A @ R).tocsr()
             return CondensedOperator(A[free][:, free], problem.contact_positions,
-                                     approximation=approximation)
+                                     factorise=factorise, approximation=approximation)
 
         material = problem.scene.material
         elastic = (material.lam, material.mu)

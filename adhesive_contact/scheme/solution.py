@@ -49,6 +49,7 @@ class Solution:
     iterations: np.ndarray        # (M+1,) Newton iterations per step
     residual: np.ndarray          # (M+1,) final relative projected residual
     timings: dict = field(default_factory=dict)
+    linear: dict = field(default_factory=dict)   # the linear backend and why: {"method", "reason"}
 
     @property
     def success(self):

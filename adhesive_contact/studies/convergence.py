@@ -48,7 +48,7 @@ from ..mesh import build_mesh
 from ..scene import scene_from_dict
 from ..storage import write_atomic, write_json
 from .pool import attempt
-from .study import RunFailed, Study, StudyError, scene_source
+from .study import RunFailed, Study, StudyError, scene_identity, scene_source
 
 REFERENCE = "reference.npz"
 LEVELS = "levels"
@@ -262,7 +262,7 @@ class ConvergenceStudy(Study):
     # -- identity and runs
 
     def identity(self):
-        return {"scene": self.scene.resolved, "param": self.param, "levels": self.levels,
+        return {"scene": scene_identity(self.scene), "param": self.param, "levels": self.levels,
                 "reference": self.reference, "ref_h": self.ref_h, "ref_k": self.ref_k}
 
     def keys(self):

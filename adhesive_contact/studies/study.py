@@ -79,6 +79,16 @@ def scene_source(scene):
         raise SceneError("", f"not valid TOML: {err}") from None
 
 
+def scene_identity(scene):
+    """What a scene contributes to a study's identity: its resolved record
+    without ``solver.linear``. The linear backend changes how the linear
+    systems are solved, not the discrete solution (every backend solves to
+    round-off or its tolerance), so a study may resume with another one."""
+    resolved = dict(scene.resolved)
+    resolved["solver"] = {k: v for k, v in resolved["solver"].items() if k != "linear"}
+    return resolved
+
+
 def study_document(identity):
     """``identity`` as plain JSON with its sha256 (of the sorted, compact JSON)."""
     study = plain(identity)

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess import beta_mean, contact_states
 from ..storage import plain, write_atomic
-from .study import Study, StudyError, scene_source
+from .study import Study, StudyError, scene_identity, scene_source
 
 MODES = ("grid", "zip")
 OUTCOMES = ("ok", "failed")
@@ -367,7 +367,7 @@ class Sweep(Study):
                 from None
 
     def identity(self):
-        return {"scene": self.base.resolved, "set": [[k, v] for k, v in self.settings],
+        return {"scene": scene_identity(self.base), "set": [[k, v] for k, v in self.settings],
                 "mode": self.mode}
 
     def keys(self):
