@@ -155,12 +155,12 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             fixed[tan[stuck]] = True
             d[tan[stuck]] = -xi[stuck]
         zmax = np.abs(z).max(initial=0.0)
-        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax).toarray()
+        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)   # sparse, nodal blocks
         d[binding] = upper[binding] - z[binding]   # onto the wall
         free = ~fixed
         if free.any():
-            rhs = -pg[free] - ((S @ np.where(fixed, d, 0.0))[free]
-                               + Hphi[np.ix_(free, fixed)] @ d[fixed])
+            moved = np.where(fixed, d, 0.0)
+            rhs = -pg[free] - ((S @ moved)[free] + (Hphi @ moved)[free])
             d[free], converged = S.newton_solve(Hphi, rhs, free)
             inner_failures += not converged
 

@@ -60,8 +60,12 @@ class DenseSchur:
 
     def newton_solve(self, H_phi, rhs, free):
         """Solve (S + H_φ)_FF d = rhs on the free coordinates F (a boolean
-        mask): ``(d, converged)``, by :func:`dense_solver`."""
-        H = self.matrix[np.ix_(free, free)] + H_phi[np.ix_(free, free)]
+        mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`.
+        Only the entries of H_φ are added to the copy of S_FF."""
+        idx = np.flatnonzero(free)
+        H = self.matrix.copy() if idx.size == free.size else self.matrix[np.ix_(idx, idx)]
+        block = sp.coo_matrix(sp.csr_matrix(H_phi)[idx][:, idx])
+        H[block.row, block.col] += block.data
         return dense_solver(H)(rhs), True
 
 
@@ -91,8 +95,9 @@ class ImplicitSchur:
     def newton_solve(self, H_phi, rhs, free):
         """Solve (S + H_φ)_FF d = rhs by CG with S applied, preconditioned by
         (approximation + H_φ)_FF: ``(d, converged)``."""
-        H_FF = H_phi[np.ix_(free, free)]
-        precondition = dense_solver(self.approximation[np.ix_(free, free)] + H_FF)
+        idx = np.flatnonzero(free)
+        H_FF = sp.csr_matrix(H_phi)[idx][:, idx]
+        precondition = dense_solver(self.approximation[np.ix_(idx, idx)] + H_FF.toarray())
         full = np.zeros(self.shape[0])
 
         def apply(v):
@@ -176,4 +181,45 @@ class CondensedOperator:
         u = np.empty(b.size)
         u[self.contact] = z
         u[self.interior] = self.solver.solve(b[self.interior] - self.A_IC @ z)
+        return u
+
+
+class PartialCondensation:
+    """The same operator as :class:`CondensedOperator` from one partial
+    Cholesky factorisation of the whole step matrix with the contact
+    unknowns last (:class:`~adhesive_contact.linear_solvers.pardiso.PardisoSchur`):
+    S comes with the factorisation, ``reduce`` is its forward half and
+    ``expand`` its backward half, so a step costs one solve pair.
+
+    Parameters
+    ----------
+    A : sparse (nfree, nfree), contact : (nC,) int, as for CondensedOperator
+    """
+
+    def __init__(self, A, contact):
+        from ..linear_solvers.pardiso import PardisoSchur
+
+        t0 = time.perf_counter()
+        self.contact = np.asarray(contact, dtype=np.int64)
+        self.solver = PardisoSchur(sp.csr_matrix(A), self.contact)
+        S = self.solver.S
+        self.S = DenseSchur(0.5 * (S + S.T))
+        self.factor_seconds = self.schur_seconds = time.perf_counter() - t0
+        self._forward = (None, None)   # (b, its forward half)
+
+    def reduce(self, b):
+        """c = b_C − A_CI A_II⁻¹ b_I (the forward half, kept for expand)."""
+        y = self.solver.forward(b)
+        self._forward = (b, y)
+        return y[self.contact].copy()
+
+    def expand(self, z, b):
+        """u with u_C = z and u_I = A_II⁻¹(b_I − A_IC z): the backward half
+        of the solve whose forward half :meth:`reduce` did for this b (done
+        again for another b)."""
+        done, y = self._forward
+        y = (y if done is b else self.solver.forward(b)).copy()
+        y[self.contact] = z
+        u = self.solver.backward(y)
+        u[self.contact] = z
         return u

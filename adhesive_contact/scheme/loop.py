@@ -21,6 +21,7 @@ from .state import (
     step_load,
     step_solve,
 )
+from .threads import one_blas_thread
 
 
 def solve(problem, progress=None, raise_on_failure=False, recorder=None):
@@ -45,28 +46,10 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     operators = StepOperators.build(problem, memory)
     contact = ContactStep(problem) if problem.boundary is not None else None
     recorder = recorder or HistoryRecorder(problem)
-    state = initial_state(problem, memory)
-    status, failure = SUCCESS, None
     t_loop = time.perf_counter()
-    for n, t in enumerate(problem.times):
-        beta = bonding_step(problem, state)                                  # (4.2)
-        b, history = step_load(problem, operators, state, n, t)
-        failure = check_load(n, t, b)
-        if failure is None:
-            level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
-                                                      beta, history, state.z)   # (4.1)
-            failure = StepFailure(n, t, result) if level is None else check_level(problem,
-                                                                                  level)
-        if failure is not None:
-            status = STEP_FAILED
-            break
-        recorder.record(level)
-        if n >= 1:
-            memory.advance(n, u)
-        state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=memory)
-        if progress is not None and progress(n, problem.scene.steps) is True:
-            status = STOPPED if n < problem.scene.steps else SUCCESS
-            break
+    with one_blas_thread():   # a step's algebra is small or latency-bound
+        status, failure, state = march(problem, operators, contact, recorder,
+                                       initial_state(problem, memory), progress)
     if failure is not None and raise_on_failure:
         raise failure
     t_end = time.perf_counter()
@@ -79,5 +62,27 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
                STOPPED: f"stopped after step {state.n} (t = {state.t:g})"}[status]
     return Solution(problem=problem, status=status, message=message, failure=failure,
                     t=problem.times[:recorder.count].copy(), timings=timings,
-                    linear=operators.linear,
-                    **recorder.history())
+                    linear=operators.linear, **recorder.history())
+
+
+def march(problem, operators, contact, recorder, state, progress=None):
+    """Levels n = 0..N from ``state``, each handed to ``recorder``: the
+    scheme itself. Returns (status, failure or None, the last state)."""
+    for n, t in enumerate(problem.times):
+        beta = bonding_step(problem, state)                                  # (4.2)
+        b, history = step_load(problem, operators, state, n, t)
+        failure = check_load(n, t, b)
+        if failure is None:
+            level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
+                                                      beta, history, state.z)   # (4.1)
+            failure = StepFailure(n, t, result) if level is None else check_level(problem,
+                                                                                  level)
+        if failure is not None:
+            return STEP_FAILED, failure, state
+        recorder.record(level)
+        if n >= 1:
+            state.memory.advance(n, u)
+        state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=state.memory)
+        if progress is not None and progress(n, problem.scene.steps) is True:
+            return (STOPPED if n < problem.scene.steps else SUCCESS), None, state
+    return SUCCESS, None, state

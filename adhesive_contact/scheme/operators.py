@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..linear_solvers import make_linear_solver
-from .condensed import CondensedOperator
+from ..linear_solvers import choose, make_linear_solver
+from .condensed import CondensedOperator, PartialCondensation
 
 
 @dataclass
@@ -45,28 +45,43 @@ class StepOperators:
         t0 = time.perf_counter()
         assembly, free = problem.assembly, problem.free
         R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
-        method = problem.scene.solver.linear
+        contact = problem.contact_positions
+        method, reason = problem.scene.solver.linear, "method {!r} was asked for."
+        if method == "auto":   # nnz of the free block, pro rata of the free dofs
+            nnz = int(assembly.K_mu.nnz * free.size / max(assembly.ndofs, 1))
+            method, reason = choose(free.size, nnz, problem.dim)
+        else:
+            reason = reason.format(method)
 
         def factorise(A_II, interior):
             # the rigid body modes of AMG in Cartesian components (the few
             # rotated dofs at Γ_C only weaken its near-nullspace there)
-            return make_linear_solver(A_II, method, dim=problem.dim, points=problem.mesh.p,
-                                      dofs=free[interior])
+            solver = make_linear_solver(A_II, method, dim=problem.dim, points=problem.mesh.p,
+                                        dofs=free[interior])
+            solver.reason = reason
+            return solver
 
         def condensed(lam, mu, approximation=None):
             A = assembly.stiffness(lam, mu)
             if R is not None:
                 A = (R.T @ A @ R).tocsr()
-            return CondensedOperator(A[free][:, free], problem.contact_positions,
-                                     factorise=factorise, approximation=approximation)
+            A = A[free][:, free]
+            if method == "pardiso" and contact.size:   # S and the solve halves in one
+                operator = PartialCondensation(A, contact)
+                operator.solver.reason = reason
+                return operator
+            return CondensedOperator(A, contact, factorise=factorise,
+                                     approximation=approximation)
 
         material = problem.scene.material
         elastic = (material.lam, material.mu)
         dlam, dmu = memory.instantaneous(problem.scene.k)
         stepped = (material.lam + dlam, material.mu + dmu)
         step = condensed(*stepped)
+        # with PARDISO the t = 0 operator forms S as cheaply as it applies it
+        approximation = None if isinstance(step, PartialCondensation) else step.S.matrix
         initial = step if (dlam, dmu) == (0.0, 0.0) else condensed(
-            *elastic, approximation=step.S.matrix)
+            *elastic, approximation=approximation)
         schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
         return cls(rotation=R, free=free, initial=initial, step=step,
                    tensors=(elastic, stepped),

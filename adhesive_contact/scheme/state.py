@@ -14,7 +14,6 @@ import numpy as np
 from ..contact_energy import ContactEnergy
 from ..expressions import coordinates
 from ..step_solver import Kink, minimise_step
-from .threads import one_blas_thread
 
 
 @dataclass
@@ -73,9 +72,8 @@ class ContactStep:
             self.kink.radius = self.energy.node_kink(problem.boundary.point_node,
                                                      problem.boundary.nodes.size)
         solver = problem.scene.solver
-        with one_blas_thread():
-            return minimise_step(S, c, self.energy, problem.upper_bound(n), z0,
-                                 solver.tol, solver.max_iter, self.kink)
+        return minimise_step(S, c, self.energy, problem.upper_bound(n), z0,
+                             solver.tol, solver.max_iter, self.kink)
 
 
 def initial_state(problem, memory):

@@ -1,11 +1,14 @@
 """Thread limits scoped to the calls that need them.
 
-The step solves factorise dense matrices of the size of Γ_C, for which a
-threaded OpenBLAS on a shared machine was 10–100× slower (a 160 × 160
-Cholesky: 0.25 ms on one thread, 2.7 ms on two, 34 ms with the second
-core busy). Only the step solve is limited, and only while it runs; one
-controller is inspected once per process (entering its limit costs about
-30 µs, against 1.4 ms for a fresh ``threadpool_limits``).
+The time loop's work is small or latency-bound: dense factorisations of
+the size of Γ_C, for which a threaded OpenBLAS on a shared machine was
+10–100× slower (a 160 × 160 Cholesky: 0.25 ms on one thread, 2.7 ms on
+two, 34 ms with the second core busy), and the triangular solves of a
+stored factorisation (PARDISO at 1e5 dofs: 9 ms a half on one thread or
+two alone, 46 ms with MKL's threads beside a busy core). So the loop runs
+on one BLAS/MKL thread, and the set-up (the factorisations) keeps the
+default. One controller is inspected once per process (entering its
+limit costs about 30 µs, against 1.4 ms for a fresh ``threadpool_limits``).
 """
 
 from functools import lru_cache
