@@ -3,13 +3,16 @@
 :func:`dask_executor` connects to a running scheduler (or wraps a
 ``distributed.Client``) and returns what
 :func:`~adhesive_contact.studies.pool.execute` needs: ``submit``,
-``as_completed``, ``share`` and ``lost_errors``. The workers need only the
-installed package: a task is :func:`~adhesive_contact.studies.pool.run_task`
-with the study's module-level ``compute``; the context (the scene, the
-settings, a fine reference) is scattered once to the workers, each of which
-builds its state from it once per process and keeps it for every run it
-computes. Records come back to the calling process, which alone writes the
-study's folder.
+``as_completed``, ``install``/``uninstall`` and ``lost_errors``. The
+workers need only the installed package: a task is
+:func:`~adhesive_contact.studies.pool.run_task` with the study's
+module-level ``compute``; the context (the scene, the settings, a fine
+reference) is given to every worker process once, by a worker plugin (so a
+worker started or restarted later gets it too); each builds its state from
+it once and keeps it for every run it computes. The runs are tasks without
+dependencies: the scheduler hands a worker one run per thread at a time,
+so a worker that dies takes only its own runs with it. Records come back to
+the calling process, which alone writes the study's folder.
 
 A worker that dies is replaced by its nanny and its run is retried by the
 scheduler (``distributed.scheduler.allowed-failures``, 3 by default); a run
@@ -18,7 +21,7 @@ that kills its worker every time comes back as lost
 had no worker for ``patience`` seconds, or the scheduler is gone,
 :class:`ClusterError` is raised.
 
-``distributed`` is imported only here, when a study is sent to a cluster.
+``distributed`` is imported only when a study is sent to a cluster.
 
 From Python::
 
@@ -39,6 +42,10 @@ POLL = 2.0
 HOST_PORT_SCHEMES = ("tcp", "tls", "ws", "wss")
 #: seconds between two looks for finished runs
 WAKE = 0.02
+
+
+def _plugin_name(token):
+    return f"adhesive-contact-study-{token}"
 
 
 class ClusterError(RuntimeError):
@@ -72,9 +79,19 @@ class DaskExecutor:
         self.lost_errors = (distributed.KilledWorker,)
         self._distributed = distributed
 
-    def share(self, context):
-        """Send the context to every worker once; a future standing for it."""
-        return self.client.scatter([context], broadcast=True, hash=False)[0]
+    def install(self, token, context):
+        """Give every worker, present and future (a restarted one too), the
+        context of study ``token``: a worker plugin, sent once per worker."""
+        from .dask_plugin import InstallContext
+
+        self.client.register_plugin(InstallContext(token, context), name=_plugin_name(token))
+
+    def uninstall(self, token):
+        """Forget the context of study ``token`` on the workers."""
+        try:
+            self.client.unregister_worker_plugin(_plugin_name(token))
+        except (OSError, TimeoutError, ValueError):
+            pass            # the cluster is gone, or never had it
 
     def submit(self, fn, *args):
         """``fn(*args)`` on a worker: one task per run (never merged with
@@ -123,7 +140,7 @@ class DaskExecutor:
         self.close()
 
 
-def dask_executor(scheduler, *, timeout=CONNECT_TIMEOUT, patience=60.0):
+def dask_executor(scheduler, *, timeout=None, patience=60.0):
     """An executor of study runs on a ``dask.distributed`` cluster.
 
     Parameters
@@ -131,8 +148,9 @@ def dask_executor(scheduler, *, timeout=CONNECT_TIMEOUT, patience=60.0):
     scheduler : str or distributed.Client
         The scheduler's address (``tcp://host:8786``) or a connected client
         (kept open by :meth:`DaskExecutor.close`).
-    timeout : float
-        Seconds to wait for the scheduler to answer.
+    timeout : float, optional
+        Seconds to wait for the scheduler to answer (default
+        :data:`CONNECT_TIMEOUT`).
     patience : float
         Seconds a study waits while the cluster has no worker before giving up.
 
@@ -148,6 +166,7 @@ def dask_executor(scheduler, *, timeout=CONNECT_TIMEOUT, patience=60.0):
     """
     if not isinstance(scheduler, str):
         return DaskExecutor(scheduler, own=False, patience=patience)
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
     try:
         import distributed
     except ImportError:

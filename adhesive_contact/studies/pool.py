@@ -11,8 +11,9 @@ The executor is pluggable: anything with ``submit(fn, *args)`` returning
 futures, with an ``as_completed(futures)`` yielding them as they finish
 (:mod:`concurrent.futures`, or :func:`~adhesive_contact.studies.executors.dask_executor`
 for a ``dask.distributed`` cluster). An executor may also have
-``share(context)`` (send the context to its workers once and return what
-stands for it in every task), ``as_completed`` (used when none is given)
+``install(token, context)`` and ``uninstall(token)`` (give its worker
+processes the context once, like the local pool's initializer, instead of
+sending it with every task), ``as_completed`` (used when none is given)
 and ``lost_errors`` (the exception types of a task whose worker died).
 
 A run whose worker died (a killed process, a lost machine) is *lost*, not
@@ -91,8 +92,9 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
         reused for many runs, the state built once per process).
     executor : object with ``submit(fn, *args)`` returning futures, optional
         Runs are submitted to it (``jobs`` ignored); its workers build the
-        state once per process. Its ``share(context)``, if any, sends the
-        context once instead of with every task.
+        state once per process. With ``install``/``uninstall`` the context
+        is installed in its workers around the study instead of being sent
+        with every task.
     as_completed : callable yielding finished futures, optional
         Default: the executor's ``as_completed`` if it has one, else
         :func:`concurrent.futures.as_completed`.
@@ -120,12 +122,18 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
             on_record(key, record)
         return None
     if executor is not None:
-        share = getattr(executor, "share", None)
-        shared = share(context) if share is not None else context
-        futures = {executor.submit(run_task, token, compute, key, shared): key for key in keys}
         completed = as_completed or getattr(executor, "as_completed", None) or futures_completed
         lost = (BrokenProcessPool, CancelledError, *getattr(executor, "lost_errors", ()))
-        return _collect(futures, completed, on_record, on_lost, lost)
+        if not hasattr(executor, "install"):
+            futures = {executor.submit(run_task, token, compute, key, context): key
+                       for key in keys}
+            return _collect(futures, completed, on_record, on_lost, lost)
+        executor.install(token, context)
+        try:
+            futures = {executor.submit(run_task, token, compute, key): key for key in keys}
+            return _collect(futures, completed, on_record, on_lost, lost)
+        finally:
+            executor.uninstall(token)
     with ProcessPoolExecutor(max_workers=min(jobs, len(keys)),
                              mp_context=multiprocessing.get_context("spawn"),
                              initializer=_install, initargs=(token, *context)) as pool:
@@ -137,22 +145,31 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
 def _collect(futures, as_completed, on_record, on_lost, lost):
     """Pass each finished run to ``on_record`` as it comes; see :func:`execute`.
 
-    ``futures`` maps each future to its run's key."""
+    ``futures`` maps each future to its run's key. When anything raises here
+    (``on_record``, an interrupt), the runs not started are cancelled."""
     failure = None
-    for future in as_completed(list(futures)):
-        if failure is not None and future.cancelled():
-            continue                    # cancelled here, after the failure
-        try:
-            key, record, message = future.result()
-        except lost as err:
-            key, record, message = futures[future], None, lost_message(err)
-            if on_lost is not None:
-                on_lost(key, message)
-                continue
-        if message is None:
-            on_record(key, record)
-        elif failure is None:
-            failure = (key, message)
-            for other in futures:
-                other.cancel()
+    try:
+        for future in as_completed(list(futures)):
+            if failure is not None and future.cancelled():
+                continue                    # cancelled here, after the failure
+            try:
+                key, record, message = future.result()
+            except lost as err:
+                key, record, message = futures[future], None, lost_message(err)
+                if on_lost is not None:
+                    on_lost(key, message)
+                    continue
+            if message is None:
+                on_record(key, record)
+            elif failure is None:
+                failure = (key, message)
+                _cancel(futures)
+    except BaseException:
+        _cancel(futures)
+        raise
     return failure
+
+
+def _cancel(futures):
+    for future in futures:
+        future.cancel()
