@@ -37,8 +37,11 @@ _LOCK = threading.Lock()   # threaded workers build a state once too
 
 
 def _install(token, setup, args):
-    """Pool initializer: remember how to build the state (built on first use)."""
-    _CONTEXTS[token] = (setup, args)
+    """Pool initializer: remember how to build the state (built on first
+    use; a state built from an earlier install is dropped)."""
+    with _LOCK:
+        _CONTEXTS[token] = (setup, args)
+        _STATES.pop(token, None)
 
 
 def _state(token, context=None):
