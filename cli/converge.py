@@ -28,9 +28,11 @@ from adhesive_contact.studies import (
     StudyMismatch,
 )
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
+from adhesive_contact.studies.executors import ClusterError
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .plots import DPI
+from .scheduler import open_executor, scheduler_option
 
 # ---------------------------------------------------------------- the table
 
@@ -194,9 +196,10 @@ def option_name(key):
 @click.option("--reference", type=click.Choice(("exact", "fine")), default=None,
               help="Measure against the scene's [exact] solution, or a fine reference "
                    "run. Default: exact if the scene has an [exact] table, else fine.")
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True,
-              help="Run the levels in this many processes (the reference runs first, "
-                   "alone).")
+@click.option("--jobs", type=click.IntRange(min=1), default=None,
+              help="Run the levels in this many local processes (the reference runs "
+                   "first, alone, here).  [default: 1]")
+@scheduler_option("levels (the fine reference runs first, here)")
 @click.option("--ref-h", type=click.IntRange(min=0), default=None,
               help="Extra mesh refinements of the fine reference beyond the finest level. "
                    "Default: 2 for --param h/hk, else 0.")
@@ -211,8 +214,8 @@ def option_name(key):
                    "for an h-study, so that the time error stays below the space error).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-converge-<param>.")
-def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, base_steps,
-             out):
+def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, base_refine,
+             base_steps, out):
     """Convergence study of SCENE (a TOML file) in h, k or both (MODEL.md §7).
 
     Prints a table of the errors ‖ε(u − u_h)‖, ‖β − β_h‖ and E (max over the
@@ -241,6 +244,7 @@ def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, b
         raise CliError(f"--out: {err.message}", 2) from None
     except StudyError as err:
         raise CliError(f"{option_name(err.key)}: {err.message}", 2) from None
+    executor = open_executor(scheduler, jobs)
     echo_warnings(problem)
     if levels < MEANINGFUL_LEVELS:
         click.echo(f"note: --levels {levels}: a least-squares rate is meaningful only over "
@@ -248,14 +252,19 @@ def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, b
 
     bars = Progress(name, study)
     try:
-        result = study.run(jobs=jobs, progress=bars)
+        result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
         files = result.files + write_plots(out, result.document, study.scene.title)
     except RunFailed as err:
         raise CliError(str(err), 1) from None
+    except ClusterError as err:
+        raise CliError(f"--scheduler {err.address}: {err.message}; the finished levels are "
+                       "saved, the same command resumes", 1) from None
     except OSError as err:
         raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
     finally:
         bars.close()
+        if executor is not None:
+            executor.close()
 
     document = result.document
     computed = len(result.computed)

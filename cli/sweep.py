@@ -23,10 +23,12 @@ from adhesive_contact.studies import (
     Sweep,
     parse_assignment,
 )
-from adhesive_contact.studies.sweep import show
+from adhesive_contact.studies.executors import ClusterError
+from adhesive_contact.studies.sweep import LOST, show
 
 from .common import CliError, load_scene, read_scene
 from .plots import DPI
+from .scheduler import open_executor, scheduler_option
 
 #: the panels of each figure: (runs.csv column, axis label)
 PANELS = (("seconds", "wall time of the run (s)"),
@@ -105,6 +107,10 @@ def table(rows, keys):
             result = (f"ok, {row['newton_total']} Newton its, β mean "
                       f"{_fmt(row['beta_mean_T'], '.4g')}, normal force "
                       f"{_fmt(row['normal_force_T'], '.4g')}")
+        elif row["outcome"] == LOST:
+            lines.append(f"run {row['run']:>3}: {settings}: LOST (its worker died; not saved: "
+                         "the same command computes it again)")
+            continue
         else:
             result = (f"FAILED at step {row['failed_step']} (t = {row['failed_t']:g}), "
                       f"residual {row['residual']:.2e}")
@@ -122,11 +128,12 @@ def table(rows, keys):
 @click.option("--grid/--zip", default=True, show_default=True,
               help="Every combination of the values (grid), or the i-th values of every "
                    "key together (zip: equal lengths).")
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True,
-              help="Run the variants in this many processes.")
+@click.option("--jobs", type=click.IntRange(min=1), default=None,
+              help="Run the variants in this many local processes.  [default: 1]")
+@scheduler_option("variants")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-sweep.")
-def sweep(scene, assignments, grid, jobs, out):
+def sweep(scene, assignments, grid, jobs, scheduler, out):
     """Run SCENE (a TOML file) for every variant given by --set.
 
     Every variant's scene is checked before anything runs. Writes runs.csv
@@ -137,7 +144,10 @@ def sweep(scene, assignments, grid, jobs, out):
     T) and one figure by_<key>.png per swept key. A run that does not
     converge is a row, not an error. The sweep resumes: each finished run is
     saved in runs/ and the same command run again computes only what is
-    missing; another sweep is refused in that folder.
+    missing; another sweep is refused in that folder. With --scheduler the
+    runs go to a dask cluster; a run whose worker died (after the
+    scheduler's retries) is a row "lost", not saved, computed again by the
+    next run of the command.
     """
     name, text = read_scene(scene)
     load_scene(text)
@@ -155,6 +165,7 @@ def sweep(scene, assignments, grid, jobs, out):
         raise CliError(f"--{err.key}: {err.message}", 2) from None
     except SceneError as err:
         raise CliError(str(err), 2) from None
+    executor = open_executor(scheduler, jobs)
     for warning in dict.fromkeys(w for _, w in study.warnings):
         runs = [str(i) for i, w in study.warnings if w == warning]
         click.echo(f"warning: run {', '.join(runs)}: {' '.join(warning.split())}", err=True)
@@ -166,19 +177,28 @@ def sweep(scene, assignments, grid, jobs, out):
         def progress(stage, done, total):
             bar.update(done - bar.pos)
         try:
-            result = study.run(jobs=jobs, progress=progress)
+            result = study.run(jobs=jobs or 1, executor=executor, progress=progress)
             files = list(result.files)
             for key in keys:
                 files.append(plot_name(key))
                 plot_key(out / files[-1], result.rows, keys, key, study.base.title)
+        except ClusterError as err:
+            raise CliError(f"--scheduler {err.address}: {err.message}; the finished runs are "
+                           "saved, the same command resumes", 1) from None
         except OSError as err:
             raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+        finally:
+            if executor is not None:
+                executor.close()
 
-    failed = sum(row["outcome"] != "ok" for row in result.rows)
+    failed = sum(row["outcome"] == "failed" for row in result.rows)
+    lost = len(result.lost)
+    computed = len(result.computed)
     click.echo(study.base.title)
     click.echo(f"  {total} runs ({'grid' if grid else 'zip'} over {', '.join(keys)}): "
-               f"{len(result.computed)} computed now, {total - len(result.computed)} loaded; "
-               f"{total - failed} ok, {failed} failed")
+               f"{computed} computed now, {total - computed - lost} loaded; "
+               f"{total - failed - lost} ok, {failed} failed"
+               + (f", {lost} lost (run the command again to compute them)" if lost else ""))
     for line in table(result.rows, keys):
         click.echo("  " + line)
     click.echo(f"  wrote {out}/: {', '.join(files)}")

@@ -3,11 +3,13 @@
 :mod:`.study` is the layer every kind of study shares (the identity in
 ``study.json``, one saved record per finished run, computing only what is
 missing); :mod:`.pool` runs the runs in this process, in local worker
-processes or on any executor; :mod:`.convergence` is the convergence study
+processes or on any executor; :mod:`.executors` is the executor of a
+``dask.distributed`` cluster; :mod:`.convergence` is the convergence study
 in h, k or both, :mod:`.sweep` a parameter sweep.
 """
 
 from .convergence import ConvergenceResult, ConvergenceStudy
+from .executors import ClusterError, DaskExecutor, dask_executor
 from .pool import execute
 from .study import (
     RunFailed,
@@ -20,6 +22,7 @@ from .study import (
 )
 from .sweep import Sweep, SweepResult, parse_assignment
 
-__all__ = ["ConvergenceResult", "ConvergenceStudy", "execute", "RunFailed", "RunStore",
+__all__ = ["ClusterError", "ConvergenceResult", "ConvergenceStudy", "DaskExecutor",
+           "dask_executor", "execute", "RunFailed", "RunStore",
            "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document",
            "Sweep", "SweepResult", "parse_assignment"]

@@ -9,14 +9,23 @@ compute and return plain data; only the calling process writes files
 
 The executor is pluggable: anything with ``submit(fn, *args)`` returning
 futures, with an ``as_completed(futures)`` yielding them as they finish
-(:mod:`concurrent.futures`, or a ``dask.distributed`` client and its
-``as_completed``).
+(:mod:`concurrent.futures`, or :func:`~adhesive_contact.studies.executors.dask_executor`
+for a ``dask.distributed`` cluster). An executor may also have
+``install(token, context)`` and ``uninstall(token)`` (give its worker
+processes the context once, like the local pool's initializer, instead of
+sending it with every task), ``as_completed`` (used when none is given)
+and ``lost_errors`` (the exception types of a task whose worker died).
+
+A run whose worker died (a killed process, a lost machine) is *lost*, not
+failed: it says nothing about the run, so it is never saved; the caller
+decides whether it stops the study or is reported and retried later.
 """
 
 import multiprocessing
 import threading
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import CancelledError, ProcessPoolExecutor
 from concurrent.futures import as_completed as futures_completed
+from concurrent.futures.process import BrokenProcessPool
 
 from ..scheme import StepFailure
 
@@ -28,8 +37,11 @@ _LOCK = threading.Lock()   # threaded workers build a state once too
 
 
 def _install(token, setup, args):
-    """Pool initializer: remember how to build the state (built on first use)."""
-    _CONTEXTS[token] = (setup, args)
+    """Pool initializer: remember how to build the state (built on first
+    use; a state built from an earlier install is dropped)."""
+    with _LOCK:
+        _CONTEXTS[token] = (setup, args)
+        _STATES.pop(token, None)
 
 
 def _state(token, context=None):
@@ -58,8 +70,14 @@ def run_task(token, compute, key, context=None):
     return attempt(compute, _state(token, context), key)
 
 
+def lost_message(err):
+    """One phrase for a run whose worker died (``err`` what the executor raised)."""
+    what = " ".join(str(err).split()) or type(err).__name__
+    return f"lost: the worker computing it died or was cut off ({type(err).__name__}: {what})"
+
+
 def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
-            as_completed=None):
+            as_completed=None, on_lost=None):
     """Compute the runs ``keys``; call ``on_record(key, record)`` as each finishes.
 
     Parameters
@@ -77,10 +95,17 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
         reused for many runs, the state built once per process).
     executor : object with ``submit(fn, *args)`` returning futures, optional
         Runs are submitted to it (``jobs`` ignored); its workers build the
-        state once per process.
+        state once per process. With ``install``/``uninstall`` the context
+        is installed in its workers around the study instead of being sent
+        with every task.
     as_completed : callable yielding finished futures, optional
-        Default :func:`concurrent.futures.as_completed`; give
-        ``distributed.as_completed`` with a dask client.
+        Default: the executor's ``as_completed`` if it has one, else
+        :func:`concurrent.futures.as_completed`.
+    on_lost : callable (key, message), optional
+        Called in this process for a run whose worker died (an exception of
+        the executor's ``lost_errors``, a broken local pool, a task
+        cancelled by the executor); the other runs go on. Without it a lost
+        run is a failure like a step failure.
 
     Returns
     -------
@@ -100,25 +125,54 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
             on_record(key, record)
         return None
     if executor is not None:
-        futures = [executor.submit(run_task, token, compute, key, context) for key in keys]
-        return _collect(futures, as_completed or futures_completed, on_record)
+        completed = as_completed or getattr(executor, "as_completed", None) or futures_completed
+        lost = (BrokenProcessPool, CancelledError, *getattr(executor, "lost_errors", ()))
+        if not hasattr(executor, "install"):
+            futures = {executor.submit(run_task, token, compute, key, context): key
+                       for key in keys}
+            return _collect(futures, completed, on_record, on_lost, lost)
+        executor.install(token, context)
+        try:
+            futures = {executor.submit(run_task, token, compute, key): key for key in keys}
+            return _collect(futures, completed, on_record, on_lost, lost)
+        finally:
+            executor.uninstall(token)
     with ProcessPoolExecutor(max_workers=min(jobs, len(keys)),
                              mp_context=multiprocessing.get_context("spawn"),
                              initializer=_install, initargs=(token, *context)) as pool:
-        futures = [pool.submit(run_task, token, compute, key) for key in keys]
-        return _collect(futures, as_completed or futures_completed, on_record)
+        futures = {pool.submit(run_task, token, compute, key): key for key in keys}
+        return _collect(futures, as_completed or futures_completed, on_record, on_lost,
+                        (BrokenProcessPool, CancelledError))
 
 
-def _collect(futures, as_completed, on_record):
+def _collect(futures, as_completed, on_record, on_lost, lost):
+    """Pass each finished run to ``on_record`` as it comes; see :func:`execute`.
+
+    ``futures`` maps each future to its run's key. When anything raises here
+    (``on_record``, an interrupt), the runs not started are cancelled."""
     failure = None
-    for future in as_completed(futures):
-        if future.cancelled():
-            continue
-        key, record, message = future.result()
-        if message is None:
-            on_record(key, record)
-        elif failure is None:
-            failure = (key, message)
-            for other in futures:
-                other.cancel()
+    try:
+        for future in as_completed(list(futures)):
+            if failure is not None and future.cancelled():
+                continue                    # cancelled here, after the failure
+            try:
+                key, record, message = future.result()
+            except lost as err:
+                key, record, message = futures[future], None, lost_message(err)
+                if on_lost is not None:
+                    on_lost(key, message)
+                    continue
+            if message is None:
+                on_record(key, record)
+            elif failure is None:
+                failure = (key, message)
+                _cancel(futures)
+    except BaseException:
+        _cancel(futures)
+        raise
     return failure
+
+
+def _cancel(futures):
+    for future in futures:
+        future.cancel()

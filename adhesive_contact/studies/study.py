@@ -231,7 +231,7 @@ class Study:
         return self.store.load(self.keys(), self.valid)
 
     def run_missing(self, done, *, jobs=1, executor=None, as_completed=None,
-                    on_record=None, label=str, context=None):
+                    on_record=None, label=str, context=None, on_lost=None):
         """Compute the runs not in ``done`` and save each the moment it finishes.
 
         ``done`` (a dict key -> record) gets the new records; ``on_record(key,
@@ -241,6 +241,9 @@ class Study:
         stops the study: no other run starts,
         those running are finished and saved, then :class:`RunFailed` is
         raised naming ``label(key)``. ``context`` replaces :meth:`context`.
+        A run whose worker died is never saved: it is passed to
+        ``on_lost(key, message)`` when given (the others go on), else it
+        stops the study like a failure.
 
         Returns the keys computed now.
         """
@@ -256,7 +259,7 @@ class Study:
         context = self.context() if context is None else context
         failure = execute(missing, type(self).compute, context, save,
                           token=self.document["sha256"], jobs=jobs, executor=executor,
-                          as_completed=as_completed)
+                          as_completed=as_completed, on_lost=on_lost)
         if failure is not None:
             raise RunFailed(label(failure[0]), failure[1])
         return missing

@@ -9,7 +9,9 @@ Every variant's scene is validated (parsed and discretised) before
 anything runs.
 
 A run that fails (a step solve that did not converge) is a result, not an
-error: its record says where it stopped. The folder:
+error: its record says where it stopped. A run whose worker died (a killed
+process, a lost machine: outcome ``"lost"``) is a row of runs.csv too, but
+it is not saved, so running the sweep again computes it. The folder:
 
 - ``study.json``: the resolved base scene, the settings and the mode, and
   the sha256 of that (another sweep in the folder is refused);
@@ -43,6 +45,8 @@ from .study import Study, StudyError, scene_identity, scene_source
 
 MODES = ("grid", "zip")
 OUTCOMES = ("ok", "failed")
+#: the outcome of a run whose worker died: a row, never a saved record
+LOST = "lost"
 #: the measured columns of runs.csv, after "run" and the swept keys
 MEASURED = ("outcome", "failed_step", "failed_t", "residual", "seconds", "newton_total",
             "newton_max", "worker_peak_rss_mib", "beta_min_T", "beta_mean_T",
@@ -299,16 +303,25 @@ def write_runs_csv(path, rows, keys):
 # ---------------------------------------------------------------- the study
 
 
+def lost_record(key, values, message):
+    """The record of run ``key`` whose worker died (outcome :data:`LOST`)."""
+    return plain({"run": key, "values": values, "outcome": LOST,
+                  "failure": {"step": None, "t": None, "residual": None, "iterations": None,
+                              "message": message}})
+
+
 @dataclass
 class SweepResult:
     """What :meth:`Sweep.run` found: ``records`` (one per run, in run order),
-    ``rows`` (the runs.csv rows), ``computed`` (runs computed now) and
-    ``files`` (names written)."""
+    ``rows`` (the runs.csv rows), ``computed`` (runs computed now, lost ones
+    excluded), ``files`` (names written) and ``lost`` (runs whose worker
+    died: rows, not saved)."""
 
     records: list
     rows: list
     computed: list
     files: list
+    lost: list = None
 
 
 class Sweep(Study):
@@ -394,19 +407,27 @@ class Sweep(Study):
 
         Returns :class:`SweepResult`. Raises StudyFolderError or
         StudyMismatch when the folder is not this sweep's, OSError when it
-        cannot be written; failed runs are results.
+        cannot be written; failed runs are results, and so are lost runs
+        (their worker died; not saved, so the next run computes them).
         """
         progress = progress or (lambda stage, done, total: None)
         self.create()
         done = self.load()
         total = len(self.runs)
+        lost = {}
         progress("runs", len(done), total)
+
+        def on_lost(key, message):
+            lost[key] = lost_record(key, self.runs[key], message)
+            progress("runs", len(done) + len(lost), total)
+
         computed = self.run_missing(
             done, jobs=jobs, executor=executor, as_completed=as_completed,
-            on_record=lambda key, record: progress("runs", len(done), total),
-            label=lambda key: f"run {key}")
-        records = [done[key] for key in self.keys()]
+            on_record=lambda key, record: progress("runs", len(done) + len(lost), total),
+            label=lambda key: f"run {key}", on_lost=on_lost)
+        records = [done[key] if key in done else lost[key] for key in self.keys()]
         rows = [run_row(record, self.keys_set) for record in records]
         write_runs_csv(self.folder / "runs.csv", rows, self.keys_set)
-        return SweepResult(records, rows, computed, ["runs.csv"])
+        return SweepResult(records, rows, [key for key in computed if key not in lost],
+                           ["runs.csv"], sorted(lost))
 

@@ -1,0 +1,188 @@
+"""Running a study's runs on a ``dask.distributed`` cluster.
+
+:func:`dask_executor` connects to a running scheduler (or wraps a
+``distributed.Client``) and returns what
+:func:`~adhesive_contact.studies.pool.execute` needs: ``submit``,
+``as_completed``, ``install``/``uninstall`` and ``lost_errors``. The
+workers need only the installed package: a task is
+:func:`~adhesive_contact.studies.pool.run_task` with the study's
+module-level ``compute``; the context (the scene, the settings, a fine
+reference) is given to every worker process once, by a worker plugin (so a
+worker started or restarted later gets it too); each builds its state from
+it once and keeps it for every run it computes. The runs are tasks without
+dependencies: the scheduler hands a worker one run per thread at a time,
+so a worker that dies takes only its own runs with it. Records come back to
+the calling process, which alone writes the study's folder.
+
+A worker that dies is replaced by its nanny and its run is retried by the
+scheduler (``distributed.scheduler.allowed-failures``, 3 by default); a run
+that kills its worker every time comes back as lost
+(``distributed.KilledWorker``). Waiting never hangs: when the cluster has
+had no worker for ``patience`` seconds, or the scheduler is gone,
+:class:`ClusterError` is raised.
+
+``distributed`` is imported only when a study is sent to a cluster.
+
+From Python::
+
+    from adhesive_contact.studies import Sweep
+    from adhesive_contact.studies.executors import dask_executor
+
+    with dask_executor("tcp://host:8786") as executor:
+        Sweep(scene, settings, folder="out").run(executor=executor)
+"""
+
+import time
+
+#: seconds to wait for a scheduler before giving up
+CONNECT_TIMEOUT = 5.0
+#: seconds between two looks at the cluster while waiting for runs
+POLL = 2.0
+#: the address schemes of the form host:port
+HOST_PORT_SCHEMES = ("tcp", "tls", "ws", "wss")
+#: seconds between two looks for finished runs
+WAKE = 0.02
+
+
+def _plugin_name(token):
+    return f"adhesive-contact-study-{token}"
+
+
+class ClusterError(RuntimeError):
+    """The cluster cannot run the study: unreachable, gone, or without workers.
+
+    ``address`` is the scheduler's address, ``message`` says what happened."""
+
+    def __init__(self, address, message):
+        self.address, self.message = address, message
+        super().__init__(f"{address}: {message}")
+
+
+class DaskExecutor:
+    """A ``distributed.Client`` as an executor of study runs (see the module
+    docstring); a context manager that closes the client it opened.
+
+    Parameters
+    ----------
+    client : distributed.Client
+    own : bool
+        Close the client on :meth:`close` (True when it was opened here).
+    patience : float
+        Seconds without any worker after which waiting gives up.
+    """
+
+    def __init__(self, client, own=False, patience=60.0):
+        import distributed
+
+        self.client, self.own, self.patience = client, own, patience
+        self.address = client.scheduler.address
+        self.lost_errors = (distributed.KilledWorker,)
+        self._distributed = distributed
+
+    def install(self, token, context):
+        """Give every worker, present and future (a restarted one too), the
+        context of study ``token``: a worker plugin, sent once per worker."""
+        from .dask_plugin import InstallContext
+
+        self.client.register_plugin(InstallContext(token, context), name=_plugin_name(token))
+
+    def uninstall(self, token):
+        """Forget the context of study ``token`` on the workers."""
+        try:
+            self.client.unregister_worker_plugin(_plugin_name(token))
+        except (OSError, TimeoutError, ValueError):
+            pass            # the cluster is gone, or never had it
+
+    def submit(self, fn, *args):
+        """``fn(*args)`` on a worker: one task per run (never merged with
+        another: ``pure=False``), no retry beyond the scheduler's own."""
+        return self.client.submit(fn, *args, pure=False)
+
+    def workers(self):
+        """The number of workers the scheduler has now."""
+        try:
+            return len(self.client.nthreads())
+        except (OSError, TimeoutError) as err:
+            raise ClusterError(self.address, f"lost the scheduler ({err})") from None
+
+    def as_completed(self, futures):
+        """Yield the futures as they finish (cancelled ones too);
+        :class:`ClusterError` when the cluster has had no worker for
+        ``patience`` seconds or the scheduler is gone."""
+        finished = self._distributed.as_completed(futures, loop=self.client.loop)
+        look, idle = time.monotonic() + POLL, None
+        while not finished.is_empty():
+            if finished.has_ready():
+                yield from finished.next_batch(block=False)
+                continue
+            time.sleep(WAKE)
+            if time.monotonic() < look:
+                continue
+            look = time.monotonic() + POLL
+            if self.workers():
+                idle = None
+                continue
+            idle = idle or time.monotonic()
+            if time.monotonic() - idle > self.patience:
+                for future in futures:
+                    future.cancel()
+                raise ClusterError(self.address, f"no worker for {self.patience:g} s; start "
+                                   f"one with: dask worker {self.address}")
+
+    def close(self):
+        if self.own:
+            self.client.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def dask_executor(scheduler, *, timeout=None, patience=60.0):
+    """An executor of study runs on a ``dask.distributed`` cluster.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client
+        The scheduler's address (``tcp://host:8786``) or a connected client
+        (kept open by :meth:`DaskExecutor.close`).
+    timeout : float, optional
+        Seconds to wait for the scheduler to answer (default
+        :data:`CONNECT_TIMEOUT`).
+    patience : float
+        Seconds a study waits while the cluster has no worker before giving up.
+
+    Returns
+    -------
+    DaskExecutor, to pass as ``executor=`` to a study's ``run``.
+
+    Raises
+    ------
+    ClusterError
+        ``distributed`` is not installed, the address is malformed, or no
+        scheduler answered there within ``timeout`` seconds.
+    """
+    if not isinstance(scheduler, str):
+        return DaskExecutor(scheduler, own=False, patience=patience)
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
+    try:
+        import distributed
+    except ImportError:
+        raise ClusterError(scheduler, "needs the package distributed "
+                           "(pip install distributed)") from None
+    try:
+        scheme, location = distributed.comm.parse_address(scheduler)
+        distributed.comm.registry.get_backend(scheme)
+        if scheme in HOST_PORT_SCHEMES:
+            distributed.comm.addressing.parse_host_port(location)
+    except ValueError as err:
+        raise ClusterError(scheduler, f"not a scheduler address ({err}); expected e.g. "
+                           "tcp://host:8786") from None
+    try:
+        client = distributed.Client(scheduler, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError):
+        raise ClusterError(scheduler, f"no dask scheduler answered there within {timeout:g} s"
+                           ) from None
+    return DaskExecutor(client, own=True, patience=patience)
