@@ -21,6 +21,7 @@ reported too.
 """
 
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 import scipy.linalg as la
@@ -40,14 +41,21 @@ def boundary_mass(u, v, w):
 
 
 def trace_constant_squared(scene):
-    """λ_max of ∫_{Γ_C} u·v = λ ∫_Ω ε(u):ε(v) on the scene's unrefined mesh."""
-    mesh = build_mesh(replace(scene.mesh, refine=0))
+    """λ_max of ∫_{Γ_C} u·v = λ ∫_Ω ε(u):ε(v) on the scene's unrefined mesh
+    (kept per mesh and sides: the variants of a sweep share it)."""
+    return _trace_constant(replace(scene.mesh, refine=0), tuple(scene.dirichlet),
+                           tuple(scene.contact_sides))
+
+
+@lru_cache(maxsize=64)
+def _trace_constant(mesh_spec, dirichlet, contact_sides):
+    mesh = build_mesh(mesh_spec)
     assembly = Assembly(mesh)
     d = mesh.dim()
-    clamped_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
+    clamped_facets = np.concatenate([mesh.boundaries[s] for s in dirichlet])
     clamped = np.unique(assembly.nodal_dofs[:, np.unique(mesh.facets[:, clamped_facets])])
     free = np.setdiff1d(np.arange(assembly.ndofs), clamped)
-    facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
+    facets = np.concatenate([mesh.boundaries[s] for s in contact_sides])
     fb = FacetBasis(mesh, vector_element(d), facets=facets, intorder=2)
     M = asm(boundary_mass, fb).tocsr()[free][:, free]
     E = (0.5 * assembly.K_mu).tocsr()[free][:, free]   # ∫ ε(u):ε(v)
