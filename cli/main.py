@@ -22,12 +22,13 @@ from pathlib import Path
 import click
 
 from adhesive_contact import solve
+from adhesive_contact.io import StreamingRecorder
 from adhesive_contact.postprocess import beta_mean
 from adhesive_contact.scheme import STOPPED
 
 from .common import CliError, echo_warnings, load_scene, read_scene
 from .converge import converge
-from .output import write_outputs
+from .output import staged_output, write_results
 from .sweep import sweep
 
 
@@ -61,7 +62,7 @@ def check_out(out):
     """Refuse (exit 2) an ``--out`` that cannot take the outputs, before the solve.
 
     An existing folder is fine: only the run's own files are replaced in it
-    (:func:`~.output.write_outputs`), a user's other files stay."""
+    (:func:`~.output.staged_output`), a user's other files stay."""
     if out.exists() and not out.is_dir():
         raise CliError(f"--out: {str(out)!r} exists and is not a folder", 2)
     existing = next(p for p in [out.absolute(), *out.absolute().parents] if p.exists())
@@ -116,15 +117,23 @@ def solve_command(scene, out):
     check_out(out)
     echo_warnings(problem)
 
-    with click.progressbar(length=parsed.steps + 1, label=f"{name}: {parsed.steps} steps",
-                           file=sys.stderr) as bar, interruptible() as interrupted:
-        solution = solve(problem, progress=lambda n, N: bar.update(1) or interrupted())
     files = []
-    if solution.t.size:   # the levels that converged, partial or not
-        try:
-            files = write_outputs(solution, out)
-        except OSError as err:
-            raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+    try:
+        with staged_output(out) as folder:
+            recorder = StreamingRecorder(problem, folder)   # levels to disk as computed
+            try:
+                with click.progressbar(length=parsed.steps + 1, file=sys.stderr,
+                                       label=f"{name}: {parsed.steps} steps") as bar, \
+                        interruptible() as interrupted:
+                    solution = solve(problem, recorder=recorder,
+                                     progress=lambda n, N: bar.update(1) or interrupted())
+                if solution.t.size:   # the levels that converged, partial or not
+                    files = write_results(solution, folder)
+            finally:
+                recorder.close()
+            files = sorted(files + recorder.names) if files else []
+    except OSError as err:
+        raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
     if solution.status == STOPPED:
         raise CliError(f"interrupted after step {solution.steps} (t = {solution.t[-1]:g}); "
                        f"the {solution.t.size} levels done were written to {out}/ "

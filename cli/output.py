@@ -1,74 +1,34 @@
 """The output folder of ``adhcontact solve`` (SPEC.md, "Command line").
 
-:func:`write_outputs` writes every file into a temporary folder and then
-moves it into place (:func:`_publish`), so a reader never sees a
-half-written ``DIR`` and a user's own files in ``DIR`` are never touched:
+:func:`staged_output` gives a temporary folder that the run writes into
+and then moves into place (:func:`_publish`), so a reader never sees a
+half-written ``DIR`` and a user's own files in ``DIR`` are never touched.
+The run streams its levels there as they are computed
+(:class:`adhesive_contact.io.StreamingRecorder`); :func:`write_results`
+adds the rest:
 
-- ``summary.json``: resolved scene, mesh counts, the smallness terms of
-  MODEL.md §2 (null without contact), the warnings of the problem, timings,
-  iterations and one record per time level (:func:`~.postprocess.step_records`);
+- ``summary.json``: resolved scene, mesh counts, how the run ended, the
+  smallness terms (null without contact), the warnings of the problem,
+  timings, the linear backend, iterations and one record per time level
+  (:func:`~.postprocess.step_records`);
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
-- ``solution.xdmf`` + ``solution.h5``: time series for ParaView with point
-  data u (3 components) and cell data stress (3×3 flattened) and von_mises
-  (without h5py installed, the data is written inline in the XDMF file and
-  there is no .h5);
-- ``contact.xdmf`` + ``contact.h5``: the contact facets with cell data beta
-  and point data u, one record per time level (only when the scene has
-  contact facets);
+- ``solution.xdmf`` + ``solution.h5`` and ``contact.xdmf`` + ``contact.h5``
+  (:mod:`adhesive_contact.io.xdmf`), written by the recorder;
 - PNG plots (:mod:`.plots`).
 """
 
+import contextlib
 import os
 import shutil
 import tempfile
 from pathlib import Path
 
-import meshio
-import numpy as np
-
-from adhesive_contact.postprocess import stress_3x3, von_mises
+from adhesive_contact.io import write_npz, write_xdmf
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 
 from . import plots
 from .postprocess import smallness_record, step_records
-
-CELL_TYPES = {2: "triangle", 3: "tetra"}
-FACET_TYPES = {2: "line", 3: "triangle"}
-
-
-class _XdmfSeriesWriter(meshio.xdmf.TimeSeriesWriter):
-    """meshio's XDMF time-series writer with the HDF5 file beside the XDMF.
-
-    meshio 5.3 opens ``Path(filename).stem + ".h5"`` relative to the current
-    directory, not to the XDMF file; this writer opens it next to the XDMF
-    file (the XDMF refers to it by base name, as the reader expects)."""
-
-    def __enter__(self):
-        if self.data_format != "HDF":
-            return super().__enter__()
-        import h5py
-
-        self.h5_filename = str(self.filename.with_suffix(".h5"))
-        self.h5_file = h5py.File(self.h5_filename, "w")
-        return self
-
-
-def pad_vectors(v):
-    """Vectors (..., d) padded with zeros to (..., 3), as ParaView expects."""
-    v = np.asarray(v, dtype=float)
-    pad = [(0, 0)] * (v.ndim - 1) + [(0, 3 - v.shape[-1])]
-    return np.pad(v, pad)
-
-
-def _data_format():
-    """"HDF" when h5py is installed (meshio needs it), else inline "XML"."""
-    try:
-        import h5py  # noqa: F401
-    except ImportError:
-        return "XML"
-    return "HDF"
-
 
 def summary(solution):
     """The ``summary.json`` document (a dict of plain JSON types)."""
@@ -117,55 +77,6 @@ def write_summary(solution, path):
     write_json(path, summary(solution))
 
 
-def contact_facets(problem):
-    """Node indices (nf, d) of the contact facets ((0, d) without Γ_C)."""
-    d = problem.mesh.dim()
-    if problem.boundary is None:
-        return np.zeros((0, d), dtype=np.int64)
-    return problem.boundary.facet_nodes.T.astype(np.int64)
-
-
-def write_npz(solution, path):
-    """Write ``solution.npz`` with exactly the firm keys of SPEC.md."""
-    problem = solution.problem
-    np.savez_compressed(
-        path,
-        points=problem.mesh.p.T,
-        cells=problem.mesh.t.T.astype(np.int64),
-        contact_facets=contact_facets(problem),
-        t=solution.t,
-        u=solution.u,
-        beta=solution.beta,
-    )
-
-
-def write_xdmf(solution, folder):
-    """Write the ParaView time series; return the names of the files written."""
-    problem = solution.problem
-    mesh = problem.mesh
-    d = mesh.dim()
-    points = mesh.p.T
-    fmt = _data_format()
-    h5 = fmt == "HDF"
-    names = ["solution.xdmf"] + ["solution.h5"] * h5
-    with _XdmfSeriesWriter(Path(folder) / names[0], fmt) as writer:
-        writer.write_points_cells(points, [(CELL_TYPES[d], mesh.t.T)])
-        for n, t in enumerate(solution.t):
-            writer.write_data(
-                float(t),
-                point_data={"u": pad_vectors(solution.u[n])},
-                cell_data={"stress": [stress_3x3(solution, n).reshape(-1, 9)],
-                           "von_mises": [von_mises(stress_3x3(solution, n))]})
-    if problem.boundary is not None and problem.boundary.facets.size:
-        names += ["contact.xdmf"] + ["contact.h5"] * h5
-        with _XdmfSeriesWriter(Path(folder) / "contact.xdmf", fmt) as writer:
-            writer.write_points_cells(points, [(FACET_TYPES[d], contact_facets(problem))])
-            for n, t in enumerate(solution.t):
-                writer.write_data(float(t), point_data={"u": pad_vectors(solution.u[n])},
-                                  cell_data={"beta": [solution.beta[n]]})
-    return names
-
-
 #: every file name ``adhcontact solve`` may write; in an existing folder a
 #: run replaces these and touches nothing else
 OUTPUT_NAMES = frozenset(
@@ -195,19 +106,17 @@ def _publish(staging, target):
     staging.rmdir()
 
 
-def write_outputs(solution, out):
-    """Write all outputs of a solve into folder ``out``, atomically.
+@contextlib.contextmanager
+def staged_output(out):
+    """A temporary folder for the outputs of ``out``, published into ``out``
+    when the block ends normally with a ``summary.json`` written
+    (:func:`_publish`) and removed otherwise.
 
     Parameters
     ----------
-    solution : adhesive_contact.Solution
     out : path of the output folder; its parents are created. In an
-        existing folder only the files of :data:`OUTPUT_NAMES` are replaced
-        (see :func:`_publish`); a user's other files stay.
-
-    Returns
-    -------
-    list of str : the names of the files written, sorted.
+        existing folder only the files of :data:`OUTPUT_NAMES` are replaced;
+        a user's other files stay.
     """
     out = Path(out).absolute()
     if out.is_dir():   # staged inside, so that os.replace stays on one file system
@@ -216,13 +125,28 @@ def write_outputs(solution, out):
         out.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-", dir=out.parent))
     try:
-        write_summary(solution, tmp / "summary.json")
-        write_npz(solution, tmp / "solution.npz")
-        write_xdmf(solution, tmp)
-        plots.write_plots(solution, tmp)
-        names = sorted(p.name for p in tmp.iterdir())
-        _publish(tmp, out)
+        yield tmp
+        if (tmp / "summary.json").exists():
+            _publish(tmp, out)
+        else:   # nothing to show: no level was computed
+            shutil.rmtree(tmp)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+def write_results(solution, folder):
+    """Write summary.json, solution.npz and the plots of a solution into
+    ``folder`` (the XDMF series are the recorder's); return their names."""
+    folder = Path(folder)
+    write_summary(solution, folder / "summary.json")
+    write_npz(solution, folder / "solution.npz")
+    return ["summary.json", "solution.npz"] + plots.write_plots(solution, folder)
+
+
+def write_outputs(solution, out):
+    """Write all outputs of a finished in-memory solution into ``out``,
+    atomically; return the names of the files written."""
+    with staged_output(out) as tmp:
+        names = sorted(write_xdmf(solution, tmp) + write_results(solution, tmp))
     return names

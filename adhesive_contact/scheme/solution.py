@@ -30,7 +30,11 @@ class Solution:
     Arrays are indexed by the time level n = 0..M, M = N for a run that
     succeeded; a run that stopped early (a step that did not converge, or
     a progress callback that asked to stop) holds the levels that converged
-    before it, and says so in ``success``, ``status``, ``message``."""
+    before it, and says so in ``success``, ``status``, ``message``. What
+    each array holds is the recorder's choice: the default
+    (:class:`~adhesive_contact.scheme.recorder.HistoryRecorder`) keeps every
+    level in memory; :class:`~adhesive_contact.io.StreamingRecorder` reads
+    u from disk and keeps σ of the last level only."""
 
     problem: object
     status: int                   # SUCCESS, STEP_FAILED or STOPPED

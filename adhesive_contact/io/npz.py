@@ -1,0 +1,40 @@
+"""``solution.npz`` (keys ``points``, ``cells``, ``contact_facets``, ``t``,
+``u``, ``beta``), written entry by entry into a compressed zip, as
+:func:`numpy.savez_compressed` would write it, but with the history u
+(N+1, npoints, d) streamed level by level from wherever it is kept."""
+
+import zipfile
+
+import numpy as np
+
+from .xdmf import contact_facets
+
+
+def _write_array(archive, name, array):
+    with archive.open(f"{name}.npy", "w", force_zip64=True) as f:
+        np.lib.format.write_array(f, np.asanyarray(array), allow_pickle=False)
+
+
+def _write_levels(archive, name, levels, count):
+    """An (count, ...) array whose level n is ``levels[n]``, one level at a time."""
+    first = np.asarray(levels[0]) if count else np.zeros((0,))
+    shape = (count, *first.shape) if count else (0,)
+    with archive.open(f"{name}.npy", "w", force_zip64=True) as f:
+        np.lib.format.write_array_header_2_0(
+            f, {"descr": np.lib.format.dtype_to_descr(np.dtype(float)),
+                "fortran_order": False, "shape": shape})
+        for n in range(count):
+            f.write(np.ascontiguousarray(levels[n], dtype=float).tobytes())
+
+
+def write_npz(solution, path):
+    """Write ``solution.npz`` of a solution (its u may be kept on disk, see
+    :class:`~adhesive_contact.io.StreamingRecorder`)."""
+    problem = solution.problem
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        _write_array(archive, "points", problem.mesh.p.T)
+        _write_array(archive, "cells", problem.mesh.t.T.astype(np.int64))
+        _write_array(archive, "contact_facets", contact_facets(problem))
+        _write_array(archive, "t", solution.t)
+        _write_levels(archive, "u", solution.u, solution.t.size)
+        _write_array(archive, "beta", solution.beta)

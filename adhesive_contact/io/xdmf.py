@@ -1,0 +1,111 @@
+"""ParaView time series of a run: ``solution.xdmf`` (+ ``.h5``) with point
+data u (3 components) and cell data stress (3 × 3 flattened, the plane
+strain σ_zz included) and von_mises; ``contact.xdmf`` (+ ``.h5``) on the
+contact facets with cell data beta and point data u (only with contact
+facets). Without h5py the data is written inline in the XDMF files."""
+
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+from ..postprocess import stress_3x3, von_mises
+
+CELL_TYPES = {2: "triangle", 3: "tetra"}
+FACET_TYPES = {2: "line", 3: "triangle"}
+
+
+class _SeriesWriter(meshio.xdmf.TimeSeriesWriter):
+    """meshio's XDMF time-series writer with the HDF5 file beside the XDMF.
+
+    meshio 5.3 opens ``Path(filename).stem + ".h5"`` relative to the current
+    directory, not to the XDMF file; this writer opens it next to the XDMF
+    file (the XDMF refers to it by base name, as the reader expects)."""
+
+    def __enter__(self):
+        if self.data_format != "HDF":
+            return super().__enter__()
+        import h5py
+
+        self.h5_filename = str(self.filename.with_suffix(".h5"))
+        self.h5_file = h5py.File(self.h5_filename, "w")
+        return self
+
+
+def data_format():
+    """"HDF" when h5py is installed (meshio needs it), else inline "XML"."""
+    try:
+        import h5py  # noqa: F401
+    except ImportError:
+        return "XML"
+    return "HDF"
+
+
+def pad_vectors(v):
+    """Vectors (..., d) padded with zeros to (..., 3), as ParaView expects."""
+    v = np.asarray(v, dtype=float)
+    return np.pad(v, [(0, 0)] * (v.ndim - 1) + [(0, 3 - v.shape[-1])])
+
+
+def contact_facets(problem):
+    """Node indices (nf, d) of the contact facets ((0, d) without Γ_C)."""
+    if problem.boundary is None:
+        return np.zeros((0, problem.dim), dtype=np.int64)
+    return problem.boundary.facet_nodes.T.astype(np.int64)
+
+
+class XdmfSeries:
+    """The open time series of one run in ``folder``: :meth:`write` one
+    level at a time (anything with ``t``, ``u`` (npoints, d), ``stress``,
+    ``stress_zz`` and ``beta``, e.g. a :class:`~adhesive_contact.scheme.state.Level`),
+    then :meth:`close`. ``names`` lists the files."""
+
+    def __init__(self, problem, folder):
+        mesh, d = problem.mesh, problem.dim
+        folder = Path(folder)
+        fmt = data_format()
+        h5 = fmt == "HDF"
+        self.names = ["solution.xdmf"] + ["solution.h5"] * h5
+        self.body = _SeriesWriter(folder / "solution.xdmf", fmt).__enter__()
+        self.body.write_points_cells(mesh.p.T, [(CELL_TYPES[d], mesh.t.T)])
+        self.contact = None
+        if problem.boundary is not None and problem.boundary.facets.size:
+            self.names += ["contact.xdmf"] + ["contact.h5"] * h5
+            self.contact = _SeriesWriter(folder / "contact.xdmf", fmt).__enter__()
+            self.contact.write_points_cells(mesh.p.T, [(FACET_TYPES[d], contact_facets(problem))])
+
+    def write(self, level):
+        stress = stress_3x3(level)
+        u = pad_vectors(level.u)
+        self.body.write_data(float(level.t), point_data={"u": u},
+                             cell_data={"stress": [stress.reshape(-1, 9)],
+                                        "von_mises": [von_mises(stress)]})
+        if self.contact is not None:
+            self.contact.write_data(float(level.t), point_data={"u": u},
+                                    cell_data={"beta": [np.asarray(level.beta)]})
+
+    def close(self):
+        for writer in (self.body, self.contact):
+            if writer is not None:
+                writer.__exit__(None, None, None)
+
+
+class _LevelOf:
+    """Level n of a solution, as :meth:`XdmfSeries.write` reads it."""
+
+    def __init__(self, solution, n):
+        self.t, self.u, self.beta = solution.t[n], solution.u[n], solution.beta[n]
+        self.stress = solution.stress[n]
+        self.stress_zz = None if solution.stress_zz is None else solution.stress_zz[n]
+
+
+def write_xdmf(solution, folder):
+    """Write the ParaView time series of a finished solution into ``folder``;
+    return the names of the files written."""
+    series = XdmfSeries(solution.problem, folder)
+    try:
+        for n in range(solution.t.size):
+            series.write(_LevelOf(solution, n))
+    finally:
+        series.close()
+    return series.names
