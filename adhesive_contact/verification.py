@@ -27,7 +27,7 @@ from skfem.quadrature import get_quadrature
 from .assembly import vector_element
 from .contact_boundary import facet_points
 from .expressions import coordinates
-from .mesh import build_mesh
+from .meshes import build_mesh
 
 
 def _one_level(coarse, fine):

@@ -44,7 +44,7 @@ from ..convergence import (
     run_reference,
     with_discretisation,
 )
-from ..mesh import build_mesh
+from ..meshes import build_mesh
 from ..scene import scene_from_dict
 from ..storage import write_atomic, write_json
 from .pool import attempt
