@@ -11,6 +11,8 @@ comes back with ``mesh.boundaries[name]`` the scikit-fem facets of each
 group.
 """
 
+import contextlib
+import io
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +41,8 @@ def _topological_dim(cell_type):
 def _read(path):
     import meshio
     try:
-        return meshio.read(path)
+        with contextlib.redirect_stdout(io.StringIO()):   # meshio prints on some formats
+            return meshio.read(path)
     except Exception as err:   # meshio raises many kinds on a malformed file
         reason = " ".join(str(err).split()) or type(err).__name__
         raise MeshFileError(f"cannot read {Path(path).name!r} as a mesh: {reason}") from None
