@@ -23,6 +23,7 @@ from .contact_boundary import (
     tangent_frame,
 )
 from .expressions import coordinates
+from .foundation import foundation_gap
 from .laws import make_bonding, make_friction, make_normal_law
 from .manufactured import ManufacturedSolution
 from .memory import make_memory
@@ -149,15 +150,8 @@ def build_problem(scene):
             or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
         columns = boundary.unknowns([0] if normal_only else np.arange(d))
         contact_positions = position[boundary.dofs.ravel()[columns]]
-        if scene.contact.gap is not None:
-            x = coordinates(mesh.p[:, boundary.nodes])
-            gap = np.array([scene.contact.gap(*x, t=t) for t in times])
-            bad = ~(np.isfinite(gap) & (gap >= 0))
-            if bad.any():
-                n, a = np.argwhere(bad)[0]
-                where = ", ".join(f"{c:g}" for c in mesh.p[:, boundary.nodes[a]])
-                raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
-                                 f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
+        if scene.contact.has_wall:
+            gap = _gap(scene, mesh, boundary, times)
         beta0 = np.ones(boundary.facets.size)
         if scene.contact.beta0 is not None and scene.contact.beta0.is_constant:
             beta0 = np.full(boundary.facets.size, float(scene.contact.beta0(0.0)))
@@ -210,6 +204,30 @@ def build_problem(scene):
                    probe_map=probe_map, times=times,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
                    beta_source=beta_source)
+
+
+def _gap(scene, mesh, boundary, times):
+    """g(x_a, t_n) (N+1, nc) at the contact nodes: the scene's gap
+    expression, or the distance to the foundation along the nodal normal
+    ν_a (:mod:`~adhesive_contact.foundation`; +∞ where the normal misses it)."""
+    x = mesh.p[:, boundary.nodes]
+    if scene.contact.foundation is not None:
+        g, depth = foundation_gap(scene.contact.foundation, x, boundary.frame[:, :, 0].T)
+        inside = depth < -1e-12 * (1.0 + np.abs(x).max())
+        if inside.any():
+            a = int(np.argmax(inside))
+            raise SceneError("contact.foundation", "the contact node "
+                             f"({', '.join(f'{c:g}' for c in x[:, a])}) lies inside the "
+                             "foundation; the body must start outside it")
+        return np.broadcast_to(g, (times.size, g.size)).copy()
+    gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
+    bad = ~(np.isfinite(gap) & (gap >= 0))
+    if bad.any():
+        n, a = np.argwhere(bad)[0]
+        where = ", ".join(f"{c:g}" for c in x[:, a])
+        raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
+                         f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
+    return gap
 
 
 def _load_point_normals(mesh, facets):

@@ -107,10 +107,26 @@ class LawSpec:
 
 
 @dataclass(frozen=True)
+class FoundationSpec:
+    """A rigid foundation the gap is measured to (``[contact.foundation]``):
+    a ``plane`` through ``point`` with unit ``normal`` (out of the
+    foundation, towards the body), a ``sphere`` (a disc in 2D) of centre
+    ``point`` and ``radius``, or a ``cylinder`` (3D) of ``radius`` around
+    the line through ``point`` along ``axis``."""
+
+    shape: str
+    point: tuple
+    normal: tuple = None
+    axis: tuple = None
+    radius: float = None
+
+
+@dataclass(frozen=True)
 class ContactSpec:
     """The ``[contact]`` table; ``ContactSpec()`` when the scene has none.
 
-    ``gap`` None: no wall; ``beta0`` None: β_0 = 1; no law is law ``"none"``
+    ``gap`` and ``foundation`` None: no wall (at most one of them is set);
+    ``beta0`` None: β_0 = 1; no law is law ``"none"``
     (``friction`` lists the laws whose potentials sum, none of them
     ``"none"``).
     """
@@ -123,6 +139,12 @@ class ContactSpec:
     bonding: LawSpec = LawSpec("none")
     beta0: object = None          # Expression for β_0, or None for β_0 = 1
     integrator: str = "explicit"  # for the bonding ODE
+    foundation: FoundationSpec = None  # the wall's geometry, instead of a gap expression
+
+    @property
+    def has_wall(self):
+        """Whether Γ_C has a rigid wall: a gap expression or a foundation."""
+        return self.gap is not None or self.foundation is not None
 
     @property
     def bonded(self):
@@ -177,7 +199,7 @@ class Scene:
         """Whether Γ_C carries anything: a wall, a normal law or friction."""
         c = self.contact
         return bool(self.contact_sides) and (
-            c.gap is not None or c.normal.law != "none" or len(c.friction) > 0
+            c.has_wall or c.normal.law != "none" or len(c.friction) > 0
             or c.bonding.law != "none")
 
     @property
@@ -244,6 +266,12 @@ def _contact_record(contact):
     if contact == ContactSpec():
         return {}
     record = {} if contact.gap is None else {"gap": contact.gap.given}
+    if contact.foundation is not None:
+        f = contact.foundation
+        record["foundation"] = {"shape": f.shape, "point": list(f.point),
+                                **({"normal": list(f.normal)} if f.normal else {}),
+                                **({"axis": list(f.axis)} if f.axis else {}),
+                                **({"radius": f.radius} if f.radius is not None else {})}
     record.update(quadrature=contact.quadrature, order=contact.order,
                   normal=_law_record(contact.normal),
                   friction=[_law_record(f) for f in contact.friction])
@@ -598,6 +626,10 @@ def _read_contact(table, dim, contact_sides):
         gap = _expression(table.key("gap"), source, _coordinates(dim) + ("t",))
         if gap.is_constant and float(gap(0.0)) < 0:
             raise SceneError(table.key("gap"), f"must be >= 0, got {source}")
+    foundation = _read_foundation(table.table("foundation"), dim)
+    if gap is not None and foundation is not None:
+        raise SceneError(table.key("foundation"), "give exactly one of contact.gap (an "
+                         "expression) and [contact.foundation] (a geometry)")
     quadrature = _choice(table.key("quadrature"),
                          table.get("quadrature", "str", "nodal"), ("nodal", "gauss"))
     order = table.get("order", "int", 4, required=False)
@@ -613,7 +645,36 @@ def _read_contact(table, dim, contact_sides):
                            if cls is not None and not cls.has_kink)
         raise SceneError(table.key("quadrature"), f"'gauss' takes smooth friction laws only "
                          f"({smooth}); {kinked[0]!r} needs 'nodal'")
-    return ContactSpec(gap, quadrature, order, normal, friction, bonding, beta0, integrator)
+    return ContactSpec(gap, quadrature, order, normal, friction, bonding, beta0, integrator,
+                       foundation)
+
+
+def _point(table, name, dim, nonzero=False):
+    value = table.get(name, "list")
+    if len(value) != dim or not all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                    and math.isfinite(c) for c in value):
+        raise SceneError(table.key(name), f"must be a list of {dim} numbers, got {_show(value)}")
+    if nonzero and not any(value):
+        raise SceneError(table.key(name), "must be a nonzero vector")
+    return tuple(float(c) for c in value)
+
+
+def _read_foundation(table, dim):
+    """A FoundationSpec of ``contact.foundation``, or None without the table."""
+    if table is None:
+        return None
+    shapes = ("plane", "sphere") if dim == 2 else ("plane", "sphere", "cylinder")
+    shape = _choice(table.key("shape"), table.get("shape", "str", "plane"), shapes)
+    point = _point(table, "point", dim)
+    normal = axis = radius = None
+    if shape == "plane":
+        normal = _point(table, "normal", dim, nonzero=True)
+    else:
+        radius = _positive(table.key("radius"), table.get("radius", "number"))
+    if shape == "cylinder":
+        axis = _point(table, "axis", dim, nonzero=True)
+    table.finish()
+    return FoundationSpec(shape, point, normal, axis, radius)
 
 
 def _read_time(table):
@@ -675,6 +736,9 @@ def _read_exact(table, dim, contact, has_loads):
                              "'none' (β frozen); use a bonding law")
     if table.has("multiplier"):
         multiplier = _expression("exact.multiplier", table.get("multiplier", "expr"), variables)
+        if contact.foundation is not None:
+            raise SceneError("exact.multiplier", "a manufactured wall needs contact.gap as "
+                             "an expression, not [contact.foundation]")
     table.finish()
     if contact.beta0 is not None:
         raise SceneError("contact.bonding.beta0", "a scene with [exact] takes β_0 from "
