@@ -178,7 +178,7 @@ def build_problem(scene):
     exact = beta_source = None
     if scene.exact is None:
         body = None if is_zero(scene.body) else vector_of(scene.body)
-        surface = [(named_facets(mesh, [side], "loads.traction"), vector_of(exprs))
+        surface = [(named_facets(mesh, [side], "loads.traction", indexed=False), vector_of(exprs))
                    for side, exprs in scene.traction.items()]
     else:
         exact = ManufacturedSolution(scene, normal_law, friction, bonding)

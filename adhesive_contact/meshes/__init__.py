@@ -41,18 +41,19 @@ def build_mesh(spec, base_dir=None):
     return refined_with_boundaries(mesh, spec.refine)
 
 
-def named_facets(mesh, names, key):
+def named_facets(mesh, names, key, indexed=True):
     """The boundary facets of the named sides ``names`` (concatenated).
 
-    Raises :class:`~adhesive_contact.scene.SceneError` on ``key[i]`` (one
-    line listing the mesh's boundary names) for a name the mesh does not
-    have, or a group that is not on the boundary."""
+    Raises :class:`~adhesive_contact.scene.SceneError` on ``key[i]`` (on
+    ``key.name`` when not ``indexed``; one line listing the mesh's boundary
+    names) for a name the mesh does not have, or a group that is not on
+    the boundary."""
     groups = mesh.boundaries or {}
     boundary = np.zeros(mesh.facets.shape[1], dtype=bool)
     boundary[mesh.boundary_facets()] = True
     out = []
     for i, name in enumerate(names):
-        where = f"{key}[{i}]" if isinstance(names, (list, tuple)) else f"{key}.{name}"
+        where = f"{key}[{i}]" if indexed else f"{key}.{name}"
         if name not in groups:
             have = ", ".join(sorted(groups)) or "none"
             raise SceneError(where, f"the mesh has no boundary group {name!r}; its groups "
