@@ -299,3 +299,28 @@ def test_a_body_inside_the_foundation_is_refused():
         build_problem(scene_from_dict(scene_dict({
             "contact.normal": law("compliance", c=1.0),
             "contact.foundation": {"point": [0.0, 0.1], "normal": [0.0, 1.0]}})))
+
+
+@pytest.mark.parametrize("path, dim", [(None, 3), (HALF_DISC, 2), (CYLINDER, 3)])
+def test_fine_contact_facets_find_their_coarse_facet(path, dim):
+    """Two refinements: each fine facet's centroid lies in its parent facet
+    (barycentric coordinates in [0, 1] and on its plane)."""
+    from adhesive_contact.verification import facet_parents, nested_meshes
+    if path is None:
+        spec = MeshSpec("box", (1.0, 0.5, 0.5), (2, 1, 1), dim=3)
+        side = "bottom"
+    else:
+        spec = scene_from_dict(file_scene(path, dim=dim)).mesh
+        side = "foot"
+    meshes = nested_meshes(spec, 2)
+    coarse, fine = meshes[0], meshes[-1]
+    cf, ff = coarse.boundaries[side], fine.boundaries[side]
+    parents = cf[facet_parents(meshes, cf, ff)]
+    centroid = fine.p[:, fine.facets[:, ff]].mean(axis=1)            # (d, n)
+    corners = coarse.p[:, coarse.facets[:, parents]]                  # (d, dim, n)
+    A = np.concatenate([corners, np.ones((1, dim, ff.size))]).transpose(2, 0, 1)
+    b = np.concatenate([centroid, np.ones((1, ff.size))]).T[:, :, None]
+    bary = np.array([np.linalg.lstsq(A[i], b[i], rcond=None)[0][:, 0] for i in range(ff.size)])
+    assert bary.min() > 0 and bary.max() < 1
+    recon = np.einsum("dvn,nv->dn", corners, bary)
+    np.testing.assert_allclose(recon, centroid, atol=1e-13)
