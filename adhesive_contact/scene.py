@@ -228,8 +228,10 @@ class Scene:
 
 
 def _mesh_record(mesh):
+    """A file mesh is recorded by its name and content (not its folder), so
+    that a study's identity does not depend on where the files live."""
     if mesh.domain == "file":
-        return {"domain": "file", "file": mesh.file, "sha256": mesh.sha256,
+        return {"domain": "file", "file": Path(mesh.file).name, "sha256": mesh.sha256,
                 "refine": mesh.refine}
     return {"domain": mesh.domain, "size": list(mesh.size), "cells": list(mesh.cells),
             "pattern": mesh.pattern, "refine": mesh.refine}

@@ -82,7 +82,7 @@ def test_mesh_file_is_relative_to_the_scene_file(tmp_path):
     scene_file.write_text(to_toml(file_scene("sub/part.msh")))
     scene = load_scene(scene_file)
     assert Path(scene.mesh.path) == (tmp_path / "sub" / "part.msh").resolve()
-    assert scene.resolved["mesh"]["file"] == "sub/part.msh"
+    assert scene.resolved["mesh"]["file"] == "part.msh"
     assert len(scene.resolved["mesh"]["sha256"]) == 64
     assert build_problem(scene).mesh.p.shape[1] == 222
     with pytest.raises(SceneError, match=r"^mesh\.file: no such file .*part\.msh"):
