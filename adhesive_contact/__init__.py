@@ -5,11 +5,11 @@ Euler bonding) on scikit-fem. See MODEL.md for the mathematics."""
 
 from .expressions import ExpressionError, compile_expression
 from .problem import Problem, build_problem
-from .scene import Scene, SceneError, parse_scene, scene_from_dict
+from .scene import Scene, SceneError, load_scene, parse_scene, scene_from_dict
 from .scheme import Solution, StepFailure, solve
 
 __version__ = "0.1.0"
 
 __all__ = ["ExpressionError", "compile_expression", "Problem", "build_problem", "Scene",
-           "SceneError", "parse_scene", "scene_from_dict", "Solution", "StepFailure",
+           "SceneError", "load_scene", "parse_scene", "scene_from_dict", "Solution", "StepFailure",
            "solve", "__version__"]

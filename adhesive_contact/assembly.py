@@ -113,6 +113,10 @@ def is_zero(expressions):
     return all(e.is_constant and float(e(0.0)) == 0.0 for e in expressions)
 
 
+#: the exactness of the rules on which LoadMap evaluates loads
+LOAD_INTORDER = 4
+
+
 class LoadMap:
     """t -> ⟨f(t), ·⟩: body forces and surface loads evaluated at fixed points.
 
@@ -124,7 +128,8 @@ class LoadMap:
         sides, and the manufactured load f_C on Γ_C)
     """
 
-    def __init__(self, mesh, body, surface, intorder=4):
+    def __init__(self, mesh, body, surface, intorder=None):
+        intorder = LOAD_INTORDER if intorder is None else intorder
         d = mesh.dim()
         elem = vector_element(d)
         self.parts = []

@@ -23,7 +23,7 @@ import numpy as np
 
 from .assembly import stiffness_basis, strain_map
 from .contact_boundary import facet_normals
-from .mesh import mesh_size
+from .meshes import mesh_size
 from .problem import build_problem
 from .scheme import solve
 from .verification import (

@@ -13,9 +13,9 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from skfem import Basis, ElementTetP1, ElementTriP1
+from skfem import Basis, ElementTetP1, ElementTriP1, FacetBasis
 
-from .assembly import Assembly, LoadMap, is_zero, vector_of
+from .assembly import LOAD_INTORDER, Assembly, LoadMap, is_zero, vector_element, vector_of
 from .contact_boundary import (
     build_contact_boundary,
     facet_normals,
@@ -23,11 +23,12 @@ from .contact_boundary import (
     tangent_frame,
 )
 from .expressions import coordinates
+from .foundation import foundation_gap
 from .laws import make_bonding, make_friction, make_normal_law
 from .manufactured import ManufacturedSolution
 from .memory import make_memory
-from .mesh import build_mesh
-from .scene import SIDES, SceneError
+from .meshes import build_mesh, named_facets
+from .scene import SceneError
 from .smallness import smallness
 
 
@@ -125,7 +126,8 @@ def build_problem(scene):
     assembly = Assembly(mesh)
     d = mesh.dim()
 
-    dirichlet_facets = np.concatenate([mesh.boundaries[s] for s in scene.dirichlet])
+    dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
+    contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
     clamped_nodes = np.unique(mesh.facets[:, dirichlet_facets])
     free = np.setdiff1d(np.arange(assembly.ndofs),
                         assembly.nodal_dofs[:, clamped_nodes].ravel())
@@ -137,8 +139,7 @@ def build_problem(scene):
     boundary, gap, beta0 = None, None, np.zeros(0)
     columns = contact_positions = np.zeros(0, dtype=np.int64)
     if scene.has_contact_terms:
-        facets = np.concatenate([mesh.boundaries[s] for s in scene.contact_sides])
-        boundary = build_contact_boundary(mesh, facets, clamped_nodes,
+        boundary = build_contact_boundary(mesh, contact_facets, clamped_nodes,
                                           scene.contact.quadrature, scene.contact.order)
         assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
         # without friction only u_ν enters the contact terms (the traces of
@@ -149,15 +150,8 @@ def build_problem(scene):
             or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
         columns = boundary.unknowns([0] if normal_only else np.arange(d))
         contact_positions = position[boundary.dofs.ravel()[columns]]
-        if scene.contact.gap is not None:
-            x = coordinates(mesh.p[:, boundary.nodes])
-            gap = np.array([scene.contact.gap(*x, t=t) for t in times])
-            bad = ~(np.isfinite(gap) & (gap >= 0))
-            if bad.any():
-                n, a = np.argwhere(bad)[0]
-                where = ", ".join(f"{c:g}" for c in mesh.p[:, boundary.nodes[a]])
-                raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
-                                 f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
+        if scene.contact.has_wall:
+            gap = _gap(scene, mesh, boundary, times)
         beta0 = np.ones(boundary.facets.size)
         if scene.contact.beta0 is not None and scene.contact.beta0.is_constant:
             beta0 = np.full(boundary.facets.size, float(scene.contact.beta0(0.0)))
@@ -184,18 +178,20 @@ def build_problem(scene):
     exact = beta_source = None
     if scene.exact is None:
         body = None if is_zero(scene.body) else vector_of(scene.body)
-        surface = [(mesh.boundaries[side], vector_of(exprs))
+        surface = [(named_facets(mesh, [side], "loads.traction", indexed=False), vector_of(exprs))
                    for side, exprs in scene.traction.items()]
     else:
         exact = ManufacturedSolution(scene, normal_law, friction, bonding)
         body = exact.body_force
-        neumann = [s for s in SIDES[d] if s not in scene.dirichlet + scene.contact_sides]
-        surface = [(mesh.boundaries[side], exact.traction(_side_normal(side, d)[:, None]))
-                   for side in neumann]
-        for side in scene.contact_sides:
-            normal = _side_normal(side, d)
-            tangents = tangent_frame(normal[:, None])[0, :, 1:].T[:, :, None]
-            surface.append((mesh.boundaries[side], exact.contact_load(normal[:, None], tangents)))
+        neumann = np.setdiff1d(mesh.boundary_facets(),
+                               np.concatenate([dirichlet_facets, contact_facets]))
+        surface = []
+        if neumann.size:
+            surface.append((neumann, exact.traction(_load_point_normals(mesh, neumann))))
+        if contact_facets.size:
+            normal = _load_point_normals(mesh, contact_facets)           # (d, npoints)
+            tangents = tangent_frame(normal)[:, :, 1:].transpose(2, 1, 0)  # (d-1, d, npoints)
+            surface.append((contact_facets, exact.contact_load(normal, tangents)))
         if boundary is not None:
             normals = _side_normals_at(mesh, boundary)
             frames = tangent_frame(normals)                     # (nq, d, d)
@@ -210,13 +206,37 @@ def build_problem(scene):
                    beta_source=beta_source)
 
 
-def _side_normal(side, d):
-    """The outward unit normal of a named side of the rectangle or box."""
-    axis, sign = {"left": (0, -1), "right": (0, 1), "bottom": (1, -1), "top": (1, 1),
-                  "front": (2, -1), "back": (2, 1)}[side]
-    n = np.zeros(d)
-    n[axis] = sign
-    return n
+def _gap(scene, mesh, boundary, times):
+    """g(x_a, t_n) (N+1, nc) at the contact nodes: the scene's gap
+    expression, or the distance to the foundation along the nodal normal
+    ν_a (:mod:`~adhesive_contact.foundation`; +∞ where the normal misses it)."""
+    x = mesh.p[:, boundary.nodes]
+    if scene.contact.foundation is not None:
+        g, depth = foundation_gap(scene.contact.foundation, x, boundary.frame[:, :, 0].T)
+        inside = depth < -1e-12 * (1.0 + np.abs(x).max())
+        if inside.any():
+            a = int(np.argmax(inside))
+            raise SceneError("contact.foundation", "the contact node "
+                             f"({', '.join(f'{c:g}' for c in x[:, a])}) lies inside the "
+                             "foundation; the body must start outside it")
+        return np.broadcast_to(g, (times.size, g.size)).copy()
+    gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
+    bad = ~(np.isfinite(gap) & (gap >= 0))
+    if bad.any():
+        n, a = np.argwhere(bad)[0]
+        where = ", ".join(f"{c:g}" for c in x[:, a])
+        raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
+                         f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
+    return gap
+
+
+def _load_point_normals(mesh, facets):
+    """Outward unit normals (d, npoints) of the facets at the points where
+    :class:`~adhesive_contact.assembly.LoadMap` evaluates a surface load
+    (each facet's own normal: the sides may be curved or slanted)."""
+    basis = FacetBasis(mesh, vector_element(mesh.dim()), facets=facets,
+                       intorder=LOAD_INTORDER)
+    return np.asarray(basis.normals).reshape(mesh.dim(), -1)
 
 
 def _side_normals_at(mesh, boundary):

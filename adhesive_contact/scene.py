@@ -1,11 +1,14 @@
 """Scenes: the validated description of one problem (SPEC.md, scene file).
 
-A scene is read from a TOML document (``parse_scene(text)``) or from the
-dictionary it decodes to (``scene_from_dict``). Every key is checked: a
-missing, unknown or wrongly typed key, or a value outside its range, raises
-:class:`SceneError` whose message is one line that names the key and says
-what is allowed. Nothing is computed here; geometry-dependent checks (a
-probe outside the mesh, a negative gap) are made when the problem is built.
+A scene is read from a file (``load_scene(path)``), a TOML document
+(``parse_scene(text, base_dir)``) or the dictionary it decodes to
+(``scene_from_dict``); ``base_dir`` is where a relative ``mesh.file`` is
+found. Every key is checked: a missing, unknown or wrongly typed key, or a
+value outside its range, raises :class:`SceneError` whose message is one
+line that names the key and says what is allowed. Nothing is computed
+here; geometry-dependent checks (a probe outside the mesh, a negative gap,
+side names that a mesh file does not have) are made when the problem is
+built.
 
 The :class:`Scene` dataclasses are the one stored form of a scene; its
 ``resolved`` record (every default filled in, written to summary.json and
@@ -16,9 +19,11 @@ absent; ``[loads]``, ``[contact]``, ``[solver]`` and ``[output]`` only
 set values that have defaults and read as those defaults when absent.
 """
 
+import hashlib
 import math
 import tomllib
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from .expressions import ExpressionError, compile_expression
 from .laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
@@ -40,13 +45,24 @@ SIDES = {2: ("left", "right", "bottom", "top"),
 
 @dataclass(frozen=True)
 class MeshSpec:
-    """The ``[mesh]`` table: a structured mesh of ``domain`` refined ``refine`` times."""
+    """The ``[mesh]`` table: a mesh of ``domain`` refined ``refine`` times.
+
+    ``domain`` "rectangle"/"box": a structured mesh of ``size`` and
+    ``cells``; "file": the mesh file ``file`` (as the scene gave it) found
+    at ``path`` (resolved against the scene file's folder), whose content
+    has the SHA-256 ``sha256`` (part of the resolved record, so that a study
+    of another mesh is another study).
+    """
 
     domain: str
-    size: tuple
-    cells: tuple
+    size: tuple = ()
+    cells: tuple = ()
     pattern: str = "diagonal"
     refine: int = 0
+    file: str = None
+    path: str = None
+    sha256: str = None
+    dim: int = None               # the space dimension (needed by a file mesh)
 
 
 @dataclass(frozen=True)
@@ -91,10 +107,26 @@ class LawSpec:
 
 
 @dataclass(frozen=True)
+class FoundationSpec:
+    """A rigid foundation the gap is measured to (``[contact.foundation]``):
+    a ``plane`` through ``point`` with unit ``normal`` (out of the
+    foundation, towards the body), a ``sphere`` (a disc in 2D) of centre
+    ``point`` and ``radius``, or a ``cylinder`` (3D) of ``radius`` around
+    the line through ``point`` along ``axis``."""
+
+    shape: str
+    point: tuple
+    normal: tuple = None
+    axis: tuple = None
+    radius: float = None
+
+
+@dataclass(frozen=True)
 class ContactSpec:
     """The ``[contact]`` table; ``ContactSpec()`` when the scene has none.
 
-    ``gap`` None: no wall; ``beta0`` None: β_0 = 1; no law is law ``"none"``
+    ``gap`` and ``foundation`` None: no wall (at most one of them is set);
+    ``beta0`` None: β_0 = 1; no law is law ``"none"``
     (``friction`` lists the laws whose potentials sum, none of them
     ``"none"``).
     """
@@ -107,6 +139,12 @@ class ContactSpec:
     bonding: LawSpec = LawSpec("none")
     beta0: object = None          # Expression for β_0, or None for β_0 = 1
     integrator: str = "explicit"  # for the bonding ODE
+    foundation: FoundationSpec = None  # the wall's geometry, instead of a gap expression
+
+    @property
+    def has_wall(self):
+        """Whether Γ_C has a rigid wall: a gap expression or a foundation."""
+        return self.gap is not None or self.foundation is not None
 
     @property
     def bonded(self):
@@ -161,7 +199,7 @@ class Scene:
         """Whether Γ_C carries anything: a wall, a normal law or friction."""
         c = self.contact
         return bool(self.contact_sides) and (
-            c.gap is not None or c.normal.law != "none" or len(c.friction) > 0
+            c.has_wall or c.normal.law != "none" or len(c.friction) > 0
             or c.bonding.law != "none")
 
     @property
@@ -170,9 +208,7 @@ class Scene:
         tables (expressions as their text, or as the number given)."""
         return {
             "title": self.title, "dim": self.dim,
-            "mesh": {"domain": self.mesh.domain, "size": list(self.mesh.size),
-                     "cells": list(self.mesh.cells), "pattern": self.mesh.pattern,
-                     "refine": self.mesh.refine},
+            "mesh": _mesh_record(self.mesh),
             "boundary": {"dirichlet": list(self.dirichlet), "contact": list(self.contact_sides)},
             "material": {**_young(self.material), "lam": self.material.lam,
                          "mu": self.material.mu},
@@ -189,6 +225,16 @@ class Scene:
 
 
 # ---------------------------------------------------------------- the resolved record
+
+
+def _mesh_record(mesh):
+    """A file mesh is recorded by its name and content (not its folder), so
+    that a study's identity does not depend on where the files live."""
+    if mesh.domain == "file":
+        return {"domain": "file", "file": Path(mesh.file).name, "sha256": mesh.sha256,
+                "refine": mesh.refine}
+    return {"domain": mesh.domain, "size": list(mesh.size), "cells": list(mesh.cells),
+            "pattern": mesh.pattern, "refine": mesh.refine}
 
 
 def _texts(expressions):
@@ -222,6 +268,12 @@ def _contact_record(contact):
     if contact == ContactSpec():
         return {}
     record = {} if contact.gap is None else {"gap": contact.gap.given}
+    if contact.foundation is not None:
+        f = contact.foundation
+        record["foundation"] = {"shape": f.shape, "point": list(f.point),
+                                **({"normal": list(f.normal)} if f.normal else {}),
+                                **({"axis": list(f.axis)} if f.axis else {}),
+                                **({"radius": f.radius} if f.radius is not None else {})}
     record.update(quadrature=contact.quadrature, order=contact.order,
                   normal=_law_record(contact.normal),
                   friction=[_law_record(f) for f in contact.friction])
@@ -386,9 +438,14 @@ def _law(table, registry):
     return LawSpec(name, params)
 
 
-def _read_mesh(table, dim):
-    domains = {2: ("rectangle",), 3: ("box",)}[dim]
+def _read_mesh(table, dim, base_dir):
+    domains = {2: ("rectangle", "file"), 3: ("box", "file")}[dim]
     domain = _choice(table.key("domain"), table.get("domain", "str"), domains)
+    refine = table.get("refine", "int", 0, required=False)
+    if refine < 0 or refine > 12:
+        raise SceneError(table.key("refine"), f"must be an integer in 0..12, got {refine}")
+    if domain == "file":
+        return _read_mesh_file(table, dim, base_dir, refine)
     size = table.get("size", "list")
     if len(size) != dim or not all(isinstance(s, (int, float)) and not isinstance(s, bool)
                                    and s > 0 for s in size):
@@ -401,18 +458,42 @@ def _read_mesh(table, dim):
                          f"got {_show(cells)}")
     patterns = ("diagonal", "cross") if dim == 2 else ("diagonal",)
     pattern = _choice(table.key("pattern"), table.get("pattern", "str", "diagonal"), patterns)
-    refine = table.get("refine", "int", 0, required=False)
-    if refine < 0 or refine > 12:
-        raise SceneError(table.key("refine"), f"must be an integer in 0..12, got {refine}")
     table.finish()
-    return MeshSpec(domain, tuple(float(s) for s in size), tuple(cells), pattern, refine)
+    return MeshSpec(domain, tuple(float(s) for s in size), tuple(cells), pattern, refine,
+                    dim=dim)
 
 
-def _read_sides(table, name, dim):
+def _read_mesh_file(table, dim, base_dir, refine):
+    """A file mesh: ``file`` is relative to ``base_dir`` (the scene file's
+    folder; the working directory when None). Its content is hashed here;
+    it is read when the problem is built."""
+    given = table.get("file", "str")
+    table.finish()
+    path = Path(given).expanduser()
+    if not path.is_absolute():
+        path = Path(base_dir if base_dir is not None else Path.cwd()) / path
+    try:
+        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    except FileNotFoundError:
+        raise SceneError(table.key("file"), f"no such file {str(path)!r} (a path relative "
+                         "to the scene file's folder)") from None
+    except OSError as err:
+        raise SceneError(table.key("file"), f"cannot read {str(path)!r}: "
+                         f"{err.strerror or err}") from None
+    return MeshSpec("file", refine=refine, file=given, path=str(path.resolve()),
+                    sha256=digest, dim=dim)
+
+
+def _read_sides(table, name, dim, named_by_file):
+    """The sides listed under ``name``: built-in side names, or (for a file
+    mesh) any names, checked against the file's groups when the mesh is built."""
     value = table.get(name, "list", [], required=False)
     sides = SIDES[dim]
     for i, side in enumerate(value):
-        if side not in sides:
+        if named_by_file and not isinstance(side, str):
+            raise SceneError(f"{table.key(name)}[{i}]", f"must be a group name (a string), "
+                             f"got {_show(side)}")
+        if not named_by_file and side not in sides:
             raise SceneError(f"{table.key(name)}[{i}]",
                              f"unknown side {_show(side)}; sides are {', '.join(sides)}")
     if len(set(value)) != len(value):
@@ -420,10 +501,10 @@ def _read_sides(table, name, dim):
     return tuple(value)
 
 
-def _read_boundary(table, dim):
+def _read_boundary(table, dim, named_by_file=False):
     """(Dirichlet sides, contact sides): disjoint, at least one Dirichlet side."""
-    dirichlet = _read_sides(table, "dirichlet", dim)
-    contact_sides = _read_sides(table, "contact", dim)
+    dirichlet = _read_sides(table, "dirichlet", dim, named_by_file)
+    contact_sides = _read_sides(table, "contact", dim, named_by_file)
     table.finish()
     if not dirichlet:
         raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0)")
@@ -464,7 +545,7 @@ def _read_memory(table, dim):
     return MemorySpec("function", function=function, tensor=tensor)
 
 
-def _read_loads(table, dim, dirichlet, contact_sides):
+def _read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
     """(body, traction): d expressions of f_0 (zero by default) and
     {side: d expressions of f_N} on Neumann sides (neither Dirichlet nor contact)."""
     body = tuple(compile_expression("0") for _ in range(dim))
@@ -480,7 +561,7 @@ def _read_loads(table, dim, dirichlet, contact_sides):
         for side, raw in tt.data.items():
             key = tt.key(side)
             tt.used.add(side)
-            if side not in SIDES[dim]:
+            if not named_by_file and side not in SIDES[dim]:
                 raise SceneError(key, f"unknown side; sides are {', '.join(SIDES[dim])}")
             if side in dirichlet or side in contact_sides:
                 raise SceneError(key, "a traction acts on a Neumann side only; "
@@ -547,6 +628,10 @@ def _read_contact(table, dim, contact_sides):
         gap = _expression(table.key("gap"), source, _coordinates(dim) + ("t",))
         if gap.is_constant and float(gap(0.0)) < 0:
             raise SceneError(table.key("gap"), f"must be >= 0, got {source}")
+    foundation = _read_foundation(table.table("foundation"), dim)
+    if gap is not None and foundation is not None:
+        raise SceneError(table.key("foundation"), "give exactly one of contact.gap (an "
+                         "expression) and [contact.foundation] (a geometry)")
     quadrature = _choice(table.key("quadrature"),
                          table.get("quadrature", "str", "nodal"), ("nodal", "gauss"))
     order = table.get("order", "int", 4, required=False)
@@ -562,7 +647,36 @@ def _read_contact(table, dim, contact_sides):
                            if cls is not None and not cls.has_kink)
         raise SceneError(table.key("quadrature"), f"'gauss' takes smooth friction laws only "
                          f"({smooth}); {kinked[0]!r} needs 'nodal'")
-    return ContactSpec(gap, quadrature, order, normal, friction, bonding, beta0, integrator)
+    return ContactSpec(gap, quadrature, order, normal, friction, bonding, beta0, integrator,
+                       foundation)
+
+
+def _point(table, name, dim, nonzero=False):
+    value = table.get(name, "list")
+    if len(value) != dim or not all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                    and math.isfinite(c) for c in value):
+        raise SceneError(table.key(name), f"must be a list of {dim} numbers, got {_show(value)}")
+    if nonzero and not any(value):
+        raise SceneError(table.key(name), "must be a nonzero vector")
+    return tuple(float(c) for c in value)
+
+
+def _read_foundation(table, dim):
+    """A FoundationSpec of ``contact.foundation``, or None without the table."""
+    if table is None:
+        return None
+    shapes = ("plane", "sphere") if dim == 2 else ("plane", "sphere", "cylinder")
+    shape = _choice(table.key("shape"), table.get("shape", "str", "plane"), shapes)
+    point = _point(table, "point", dim)
+    normal = axis = radius = None
+    if shape == "plane":
+        normal = _point(table, "normal", dim, nonzero=True)
+    else:
+        radius = _positive(table.key("radius"), table.get("radius", "number"))
+    if shape == "cylinder":
+        axis = _point(table, "axis", dim, nonzero=True)
+    table.finish()
+    return FoundationSpec(shape, point, normal, axis, radius)
 
 
 def _read_time(table):
@@ -624,6 +738,9 @@ def _read_exact(table, dim, contact, has_loads):
                              "'none' (β frozen); use a bonding law")
     if table.has("multiplier"):
         multiplier = _expression("exact.multiplier", table.get("multiplier", "expr"), variables)
+        if contact.foundation is not None:
+            raise SceneError("exact.multiplier", "a manufactured wall needs contact.gap as "
+                             "an expression, not [contact.foundation]")
     table.finish()
     if contact.beta0 is not None:
         raise SceneError("contact.bonding.beta0", "a scene with [exact] takes β_0 from "
@@ -635,18 +752,22 @@ def _coordinates(dim):
     return ("x", "y") if dim == 2 else ("x", "y", "z")
 
 
-def scene_from_dict(data):
-    """Validate a decoded scene document and return a :class:`Scene`."""
+def scene_from_dict(data, base_dir=None):
+    """Validate a decoded scene document and return a :class:`Scene`;
+    ``base_dir`` is the folder a relative ``mesh.file`` is taken in
+    (default: the working directory)."""
     top = _Table(data, "")
     title = top.get("title", "str", "untitled", required=False)
     dim = top.get("dim", "int")
     if dim not in (2, 3):
         raise SceneError("dim", f"must be 2 (plane strain) or 3, got {dim}")
-    mesh = _read_mesh(top.table("mesh", required=True), dim)
-    dirichlet, contact_sides = _read_boundary(top.table("boundary", required=True), dim)
+    mesh = _read_mesh(top.table("mesh", required=True), dim, base_dir)
+    by_file = mesh.domain == "file"
+    dirichlet, contact_sides = _read_boundary(top.table("boundary", required=True), dim,
+                                              by_file)
     material = _read_material(top.table("material", required=True), dim)
     memory = _read_memory(top.table("memory"), dim)
-    body, traction = _read_loads(top.table("loads"), dim, dirichlet, contact_sides)
+    body, traction = _read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)
     contact = _read_contact(top.table("contact"), dim, contact_sides)
     T, steps = _read_time(top.table("time", required=True))
     solver = _read_solver(top.table("solver"))
@@ -657,10 +778,18 @@ def scene_from_dict(data):
                  traction, contact, T, steps, solver, probes, exact)
 
 
-def parse_scene(text):
-    """Parse a TOML scene document; TOML syntax errors become SceneError."""
+def parse_scene(text, base_dir=None):
+    """Parse a TOML scene document; TOML syntax errors become SceneError.
+    ``base_dir``: the folder a relative ``mesh.file`` is taken in."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SceneError("", f"not valid TOML: {err}") from None
-    return scene_from_dict(data)
+    return scene_from_dict(data, base_dir)
+
+
+def load_scene(path):
+    """Read and parse the scene file ``path``; a relative ``mesh.file`` is
+    taken in the scene file's folder. OSError if the file cannot be read."""
+    path = Path(path)
+    return parse_scene(path.read_text(encoding="utf-8"), base_dir=path.parent)

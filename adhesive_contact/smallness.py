@@ -31,7 +31,7 @@ from skfem import BilinearForm, FacetBasis, asm
 from skfem.helpers import dot
 
 from .assembly import Assembly, vector_element
-from .mesh import build_mesh
+from .meshes import build_mesh
 
 
 @BilinearForm

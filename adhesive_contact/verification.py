@@ -9,7 +9,9 @@ fine mesh exactly: meshes of one scene at refine r and r + 1 are nested
 (``refined()`` keeps the coarse vertices first and adds one per coarse edge,
 in edge order), so P1 prolongation is the identity on old vertices and the
 mean of the two ends on each new one, and a fine contact facet inherits
-the P0 value of the coarse facet it halves. The fine strain is constant per
+the P0 value of the coarse facet it refines (in 2D and 3D; for a file
+mesh the new vertices are chord midpoints: a curved side is not
+re-projected, so the levels approximate the coarse mesh's polygon). The fine strain is constant per
 fine cell, so the error integral is exact with one point.
 
 Against an exact solution, ε(u*) is integrated with a cell rule of
@@ -27,7 +29,7 @@ from skfem.quadrature import get_quadrature
 from .assembly import vector_element
 from .contact_boundary import facet_points
 from .expressions import coordinates
-from .mesh import build_mesh
+from .meshes import build_mesh, refinement_parents
 
 
 def _one_level(coarse, fine):
@@ -63,19 +65,15 @@ def prolongation(meshes):
 def facet_parents(meshes, coarse_facets, fine_facets):
     """For each fine contact facet, its position in ``coarse_facets``.
 
-    A fine boundary facet halves a coarse one: in 2D one of its vertices is
-    the new midpoint vertex of its parent edge.
+    A fine boundary facet lies in one coarse facet: the one spanned by the
+    coarse vertices its vertices come from
+    (:func:`~adhesive_contact.meshes.refinement_parents`), in 2D and 3D.
     """
-    if meshes[0].dim() != 2:
-        raise ValueError("facet parents (fine references) are implemented for 2D meshes only")
     parent = np.asarray(fine_facets)
     for coarse, fine in zip(meshes[-2::-1], meshes[:0:-1]):
-        nc = coarse.p.shape[1]
-        nodes = fine.facets[:, parent]
-        new = np.where(nodes[0] >= nc, nodes[0], nodes[1])
-        if np.any(new < nc):
-            raise ValueError("a fine contact facet has no new vertex: meshes not nested")
-        parent = new - nc   # coarse edge index = coarse facet index in 2D
+        parent = refinement_parents(coarse, fine, parent)
+        if np.any(parent < 0):
+            raise ValueError("a fine contact facet lies in no coarse facet: meshes not nested")
     position = np.full(meshes[0].facets.shape[1], -1)
     position[coarse_facets] = np.arange(len(coarse_facets))
     out = position[parent]

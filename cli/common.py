@@ -5,7 +5,9 @@ Every command parses and validates its scene with these before it creates
 any output, so a bad scene exits 2 with one line and writes nothing.
 """
 
+import tomllib
 from importlib import resources
+from pathlib import Path
 
 import click
 
@@ -39,13 +41,34 @@ def read_scene(path):
         raise CliError(f"SCENE: cannot read {str(path)!r}: {reason}", 2) from None
 
 
-def load_scene(text):
-    """(scene, problem) of a TOML scene text; a bad scene is a :class:`CliError` (exit 2)."""
+def scene_folder(path):
+    """The folder a scene file's relative paths (``mesh.file``) are taken in:
+    the file's own (the working directory for the built-in scene)."""
+    return None if path is None else Path(path).parent
+
+
+def load_scene(text, base_dir=None):
+    """(scene, problem) of a TOML scene text whose relative paths are taken
+    in ``base_dir`` (:func:`scene_folder`), as the library's
+    ``load_scene(path)`` does; a bad scene is a :class:`CliError` (exit 2)."""
     try:
-        scene = parse_scene(text)
+        scene = parse_scene(text, base_dir)
         return scene, build_problem(scene)
     except SceneError as err:
         raise CliError(str(err), 2) from None
+
+
+def study_source(text, base_dir=None):
+    """The decoded document of a valid scene text for a study, a relative
+    ``mesh.file`` made absolute (a study's workers do not know the scene
+    file's folder)."""
+    document = tomllib.loads(text)
+    mesh = document.get("mesh")
+    if base_dir is not None and isinstance(mesh, dict) and isinstance(mesh.get("file"), str):
+        path = Path(mesh["file"]).expanduser()
+        if not path.is_absolute():
+            mesh["file"] = str((Path(base_dir) / path).resolve())
+    return document
 
 
 def echo_warnings(problem):

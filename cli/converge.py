@@ -30,7 +30,14 @@ from adhesive_contact.studies import (
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
 from adhesive_contact.studies.executors import ClusterError
 
-from .common import CliError, echo_warnings, load_scene, read_scene
+from .common import (
+    CliError,
+    echo_warnings,
+    load_scene,
+    read_scene,
+    scene_folder,
+    study_source,
+)
 from .plots import DPI
 from .scheduler import open_executor, scheduler_option
 
@@ -230,10 +237,10 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     more --levels too) is refused in that folder: use another --out.
     """
     name, text = read_scene(scene)
-    _, problem = load_scene(text)
+    _, problem = load_scene(text, scene_folder(scene))
     out = Path(out) if out is not None else Path.cwd() / f"{name}-converge-{param}"
     try:
-        study = ConvergenceStudy(text, param, levels, reference, folder=out, ref_h=ref_h,
+        study = ConvergenceStudy(study_source(text, scene_folder(scene)), param, levels, reference, folder=out, ref_h=ref_h,
                                  ref_k=ref_k, refine=base_refine, steps=base_steps,
                                  scene_file=str(scene))
         study.open()

@@ -26,7 +26,7 @@ from adhesive_contact.io import StreamingRecorder
 from adhesive_contact.postprocess import beta_mean
 from adhesive_contact.scheme import STOPPED
 
-from .common import CliError, echo_warnings, load_scene, read_scene
+from .common import CliError, echo_warnings, load_scene, read_scene, scene_folder
 from .converge import converge
 from .output import staged_output, write_results
 from .sweep import sweep
@@ -112,7 +112,7 @@ def solve_command(scene, out):
     plots into the output folder.
     """
     name, text = read_scene(scene)
-    parsed, problem = load_scene(text)
+    parsed, problem = load_scene(text, scene_folder(scene))
     out = Path(out) if out is not None else Path.cwd() / name
     check_out(out)
     echo_warnings(problem)

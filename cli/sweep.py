@@ -26,7 +26,7 @@ from adhesive_contact.studies import (
 from adhesive_contact.studies.executors import ClusterError
 from adhesive_contact.studies.sweep import LOST, show
 
-from .common import CliError, load_scene, read_scene
+from .common import CliError, load_scene, read_scene, scene_folder, study_source
 from .plots import DPI
 from .scheduler import open_executor, scheduler_option
 
@@ -150,11 +150,11 @@ def sweep(scene, assignments, grid, jobs, scheduler, out):
     next run of the command.
     """
     name, text = read_scene(scene)
-    load_scene(text)
+    load_scene(text, scene_folder(scene))
     out = Path(out) if out is not None else Path.cwd() / f"{name}-sweep"
     try:
         settings = [parse_assignment(a) for a in assignments]
-        study = Sweep(text, settings, "grid" if grid else "zip", folder=out)
+        study = Sweep(study_source(text, scene_folder(scene)), settings, "grid" if grid else "zip", folder=out)
         study.open()
     except StudyMismatch as err:
         raise CliError(f"--out {out} holds a different sweep ({err.difference}); "

@@ -2,6 +2,7 @@
 the firm outputs, the fine reference, resuming, refusing another study and
 running levels in parallel. Tiny scenes (4x2 cells, a few steps, 3 levels)."""
 
+import csv
 import inspect
 import json
 import shutil
@@ -424,15 +425,18 @@ def test_finished_study_rerun_with_jobs_computes_nothing(fine_study, tmp_path, s
     assert counting.levels == [] and counting.reference == 0
 
 
-def test_fine_reference_in_3d_with_contact_exits_2(tmp_path):
+def test_fine_reference_in_3d_with_contact(tmp_path):
+    """3D fine references carry β between nested meshes (a fine facet finds
+    the coarse facet it refines): the study runs and the error falls."""
     text = to_toml(scene_dict({"dim": 3, "mesh.domain": "box", "mesh.size": [1.0, 0.5, 0.5],
                                "mesh.cells": [2, 1, 1], "loads.body": ["0", "-400*t", "0"]},
                               CONTACT))
     path = tmp_path / "box.toml"
     path.write_text(text)
-    result = run(path, "--param", "h", "--levels", 2, "--out", tmp_path / "out")
-    assert_one_line_error(result, 2, "--reference: 'fine'")
-    assert not (tmp_path / "out").exists()
+    result = run(path, "--param", "h", "--levels", 2, "--ref-h", 1, "--out", tmp_path / "out")
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    rows = list(csv.DictReader((tmp_path / "out" / "errors.csv").open()))
+    assert len(rows) == 2 and 0 < float(rows[1]["E"]) < float(rows[0]["E"])
 
 
 def test_a_study_too_large_for_the_machine_is_refused(tmp_path):

@@ -29,7 +29,7 @@ from adhesive_contact.linear_solvers import (
     pardiso,
     rigid_body_modes,
 )
-from adhesive_contact.mesh import side_tests
+from adhesive_contact.meshes import side_tests
 
 LAM, MU = 576.9230769230769, 384.6153846153846   # E = 1000, ν = 0.3
 EPS = np.finfo(float).eps

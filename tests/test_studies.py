@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from adhesive_contact import build_problem, parse_scene, solve
+from adhesive_contact import build_problem, load_scene, parse_scene, solve
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "studies").glob("*/*.toml"))
@@ -16,8 +16,9 @@ SCENES = sorted((ROOT / "studies").glob("*/*.toml"))
 
 @pytest.mark.parametrize("path", SCENES, ids=lambda p: f"{p.parent.name}/{p.stem}")
 def test_every_committed_scene_runs(path):
-    """Each scene parses, builds and runs (at most 4 steps on its own mesh)."""
-    scene = parse_scene(path.read_text())
+    """Each scene parses, builds and runs (at most 4 steps on its own mesh);
+    a mesh file is found relative to the scene file."""
+    scene = load_scene(path)
     scene = replace(scene, steps=min(scene.steps, 4), T=scene.T * min(scene.steps, 4) / scene.steps)
     solution = solve(build_problem(scene))
     assert np.isfinite(solution.u).all()

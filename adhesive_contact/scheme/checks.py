@@ -77,7 +77,8 @@ def check_level(problem, level):
         u_nu = level.frame_displacement[:, 0]
         excess = u_nu - gap[n]
         worst = int(np.argmax(excess))
-        scale = 1.0 + max(np.abs(gap[n]).max(), np.abs(u_nu).max())
+        finite = np.isfinite(gap[n])   # +inf: no wall at the node
+        scale = 1.0 + max(np.abs(gap[n][finite]).max(initial=0.0), np.abs(u_nu).max())
         if excess[worst] > WALL_SLACK * scale:
             x = problem.mesh.p[:, problem.boundary.nodes[worst]]
             return InvalidState(n, t, (

@@ -44,7 +44,7 @@ from ..convergence import (
     run_reference,
     with_discretisation,
 )
-from ..mesh import build_mesh
+from ..meshes import build_mesh
 from ..scene import scene_from_dict
 from ..storage import write_atomic, write_json
 from .pool import attempt
@@ -240,9 +240,6 @@ class ConvergenceStudy(Study):
         if reference == "exact" and self.scene.exact is None:
             raise StudyError("reference", "'exact' needs an [exact] table in the scene; "
                              "allowed here: fine")
-        if reference == "fine" and self.scene.dim == 3 and self.scene.has_contact_terms:
-            raise StudyError("reference", "'fine' carries β between nested meshes in 2D "
-                             "only; allowed for this 3D scene: exact (add an [exact] table)")
         if reference == "exact" and (ref_h is not None or ref_k is not None):
             raise StudyError("ref_h/ref_k", "refine the fine reference; allowed only with "
                              "reference fine (the reference here is the exact solution)")

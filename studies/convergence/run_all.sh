@@ -24,3 +24,7 @@ case=e_peel_reference
 adhcontact converge "$case.toml" --param h --levels 5 --reference fine --jobs "$jobs" --out "$out/$case-h"
 adhcontact converge "$case.toml" --param k --levels 5 --refine 2 --steps 16 --reference fine --jobs "$jobs" --out "$out/$case-k"
 adhcontact converge "$case.toml" --param hk --levels 5 --steps 16 --reference fine --jobs "$jobs" --out "$out/$case-hk"
+# (f) 3D manufactured case on the box; (g) 2D manufactured case on a gmsh mesh
+# (studies/meshes/plate_with_hole.msh): h-studies against the exact solution.
+adhcontact converge f_box_3d.toml --param h --levels 4 --steps 64 --jobs "$jobs" --out "$out/f_box_3d-h"
+adhcontact converge g_plate_with_hole.toml --param h --levels 5 --steps 256 --jobs "$jobs" --out "$out/g_plate_with_hole-h"

@@ -1,4 +1,4 @@
-"""Structured meshes of the scene's domain with named sides.
+"""Structured meshes of the built-in domains, with named sides.
 
 A rectangle [0, L_x] × [0, L_y] is cut into ``cells`` quadrilaterals, each
 split into two triangles (``pattern = "diagonal"``) or into four around its
@@ -12,6 +12,10 @@ Sides are named as scikit-fem does: left/right (x = 0, L_x), bottom/top
 
 import numpy as np
 from skfem import MeshQuad, MeshTet, MeshTri
+
+#: the named sides of the rectangle (2D) and of the box (3D)
+SIDES = {2: ("left", "right", "bottom", "top"),
+         3: ("left", "right", "bottom", "top", "front", "back")}
 
 
 def side_tests(size):
@@ -27,8 +31,9 @@ def side_tests(size):
     return tests
 
 
-def build_mesh(spec):
-    """The mesh of a :class:`~adhesive_contact.scene.MeshSpec`, sides named."""
+def structured_mesh(spec):
+    """The rectangle or box of a :class:`~adhesive_contact.scene.MeshSpec`,
+    refined ``spec.refine`` times, sides named."""
     axes = [np.linspace(0.0, length, n + 1) for length, n in zip(spec.size, spec.cells)]
     if spec.domain == "rectangle":
         if spec.pattern == "cross":
@@ -42,10 +47,3 @@ def build_mesh(spec):
     if spec.refine:
         mesh = mesh.refined(spec.refine)
     return mesh.with_boundaries(side_tests(spec.size))
-
-
-def mesh_size(mesh):
-    """The largest edge length h of the mesh."""
-    edges = mesh.facets if mesh.dim() == 2 else mesh.edges
-    p = mesh.p[:, edges]
-    return float(np.max(np.linalg.norm(p[:, 1] - p[:, 0], axis=0)))

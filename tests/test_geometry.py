@@ -1,0 +1,326 @@
+"""Real geometry: meshes from files, curved contact sides, the gap from a
+foundation's geometry.
+
+The committed meshes are made by studies/meshes/make_meshes.py (gmsh); the
+tests also write small meshes with meshio to check what the reader refuses.
+"""
+
+from dataclasses import replace
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from conftest import DELETE, law, run, scene_dict, to_toml
+
+from adhesive_contact import (
+    SceneError,
+    build_problem,
+    load_scene,
+    parse_scene,
+    scene_from_dict,
+    solve,
+)
+from adhesive_contact.contact_boundary import facet_normals
+from adhesive_contact.meshes import build_mesh, read_mesh_file
+from adhesive_contact.meshes.builtin import structured_mesh
+from adhesive_contact.scene import MeshSpec
+from adhesive_contact.verification import prolongation
+from adhesive_contact_cli.main import main
+
+MESHES = Path(__file__).resolve().parents[1] / "studies" / "meshes"
+HALF_DISC = MESHES / "half_disc.msh"
+CYLINDER = MESHES / "cylinder_foot.msh"
+
+
+def file_scene(path, changes=None, dim=2):
+    """A scene on the mesh file ``path`` (top clamped, foot the contact side)."""
+    base = {"dim": dim, "mesh": {"domain": "file", "file": str(path)},
+            "boundary": {"dirichlet": ["top"], "contact": ["foot"]},
+            "material": {"E": 1000.0, "nu": 0.3}, "time": {"T": 1.0, "steps": 1}}
+    return scene_dict(changes, base)
+
+
+def write_msh(path, mesh, sides, cell_type=None, cells=None):
+    """Write a scikit-fem mesh (or other cells) as gmsh 2.2 with named sides."""
+    d = mesh.dim()
+    facet = "line" if d == 2 else "triangle"
+    blocks = [(facet, mesh.facets[:, mesh.boundaries[s]].T) for s in sides]
+    blocks.append((cell_type or ("triangle" if d == 2 else "tetra"),
+                   mesh.t.T if cells is None else cells))
+    tags = [np.full(len(b[1]), i + 1) for i, b in enumerate(blocks)]
+    field = {s: np.array([i + 1, d - 1]) for i, s in enumerate(sides)}
+    field["body"] = np.array([len(sides) + 1, d])
+    points = mesh.p.T if d == 3 else np.column_stack([mesh.p.T, np.zeros(mesh.p.shape[1])])
+    meshio.write(path, meshio.Mesh(points, blocks, cell_data={
+        "gmsh:physical": tags, "gmsh:geometrical": tags}, field_data=field),
+        file_format="gmsh22", binary=False)
+
+
+# ---------------------------------------------------------------- reading files
+
+
+def test_gmsh_formats_22_and_41_give_the_same_mesh():
+    a = read_mesh_file(HALF_DISC, 2)
+    b = read_mesh_file(MESHES / "half_disc_v22.msh", 2)
+    assert np.array_equal(a.p, b.p) and np.array_equal(a.t, b.t)
+    assert set(a.boundaries) == {"top", "foot"}
+    for name in a.boundaries:
+        assert np.array_equal(a.boundaries[name], b.boundaries[name])
+    # the groups are the arc and the flat side: every foot vertex on the unit circle
+    foot = np.unique(a.facets[:, a.boundaries["foot"]])
+    np.testing.assert_allclose(np.hypot(a.p[0, foot], a.p[1, foot] - 1.0), 1.0, atol=1e-12)
+    top = np.unique(a.facets[:, a.boundaries["top"]])
+    np.testing.assert_allclose(a.p[1, top], 1.0, atol=1e-12)
+
+
+def test_mesh_file_is_relative_to_the_scene_file(tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "part.msh").write_bytes(HALF_DISC.read_bytes())
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(to_toml(file_scene("sub/part.msh")))
+    scene = load_scene(scene_file)
+    assert Path(scene.mesh.path) == (tmp_path / "sub" / "part.msh").resolve()
+    assert scene.resolved["mesh"]["file"] == "part.msh"
+    assert len(scene.resolved["mesh"]["sha256"]) == 64
+    assert build_problem(scene).mesh.p.shape[1] == 222
+    with pytest.raises(SceneError, match=r"^mesh\.file: no such file .*part\.msh"):
+        parse_scene(scene_file.read_text(), base_dir=tmp_path / "elsewhere")
+
+
+def test_wrong_group_name_lists_the_groups(tmp_path):
+    with pytest.raises(SceneError) as err:
+        build_problem(scene_from_dict(file_scene(HALF_DISC, {"boundary.contact": ["bottom"]})))
+    assert str(err.value) == ("boundary.contact[0]: the mesh has no boundary group 'bottom'; "
+                              "its groups are: foot, top")
+    with pytest.raises(SceneError, match=r"^loads\.traction\.side: .* its groups are: foot, top"):
+        build_problem(scene_from_dict(file_scene(HALF_DISC, {
+            "boundary.contact": [], "loads.traction": {"side": [0, 1]}})))
+    # the CLI: one line, exit 2, nothing written
+    path = tmp_path / "bad.toml"
+    path.write_text(to_toml(file_scene(HALF_DISC, {"boundary.dirichlet": ["lid"]})))
+    result = CliRunner().invoke(main, ["solve", str(path), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2
+    assert result.output.strip().splitlines() == [
+        "error: boundary.dirichlet[0]: the mesh has no boundary group 'lid'; its groups are: "
+        "foot, top"]
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("cells, message", [
+    ("quad", "cells of type 'quad'; supported are first-order triangle cells only in 2D"),
+    ("triangle6", "cells of type 'triangle6'"),
+    ("none", "has no 2D cells of the scene's dim = 2 (cell types found: line); in gmsh, "
+             "put the surface in a physical group"),
+])
+def test_unsupported_cells_are_refused(tmp_path, cells, message):
+    mesh = structured_mesh(MeshSpec("rectangle", (2.0, 1.0), (2, 1)))
+    path = tmp_path / "m.msh"
+    if cells == "quad":
+        write_msh(path, mesh, ["bottom", "top"], "quad", np.array([[0, 3, 4, 1]]))
+    elif cells == "triangle6":
+        write_msh(path, mesh, ["bottom", "top"], "triangle6",
+                  np.array([[0, 3, 4, 1, 2, 5]]))
+    else:
+        write_msh(path, mesh, ["bottom", "top"], "line", mesh.facets[:, :1].T)
+    with pytest.raises(SceneError, match=r"^mesh\.file: .*" + message.replace("(", r"\(")
+                       .replace(")", r"\)")):
+        build_problem(scene_from_dict(file_scene(path, {"boundary.contact": ["bottom"]})))
+
+
+def test_points_off_the_plane_are_refused_in_2d(tmp_path):
+    raw = meshio.read(HALF_DISC)
+    raw.points[:, 2] = 0.1 * raw.points[:, 0]
+    meshio.write(tmp_path / "tilted.msh", raw, file_format="gmsh22", binary=False)
+    with pytest.raises(SceneError, match=r"^mesh\.file: 'tilted\.msh' has points off the "
+                                         r"plane z = 0"):
+        build_problem(scene_from_dict(file_scene(tmp_path / "tilted.msh")))
+
+
+def test_scene_reader_keeps_the_builtin_side_check():
+    with pytest.raises(SceneError, match=r"boundary\.contact\[0\]: unknown side 'foot'; "
+                                         "sides are left, right, bottom, top"):
+        scene_from_dict(scene_dict({"boundary.contact": ["foot"]}))
+    with pytest.raises(SceneError, match=r"^mesh\.cells: unknown key; allowed here: domain, file, "
+                                         "refine"):
+        scene_from_dict(file_scene(HALF_DISC, {"mesh.cells": [2, 2]}))
+
+
+# ---------------------------------------------------------------- refinement
+
+
+@pytest.mark.parametrize("path, dim", [(HALF_DISC, 2), (CYLINDER, 3)])
+def test_refined_file_meshes_are_nested_and_keep_their_groups(path, dim):
+    spec = scene_from_dict(file_scene(path, dim=dim,
+                                      changes={"boundary.dirichlet": ["top"]})).mesh
+    coarse, fine = build_mesh(spec), build_mesh(replace(spec, refine=1))
+    P = prolongation([coarse, fine])    # raises unless fine refines coarse
+    np.testing.assert_allclose(P @ coarse.p.T, fine.p.T, atol=1e-14)
+    for name, facets in coarse.boundaries.items():
+        assert fine.boundaries[name].size == 2 ** (dim - 1) * facets.size
+        # the fine group covers the coarse one: equal measures
+        assert facet_normals(fine, fine.boundaries[name])[1].sum() == pytest.approx(
+            facet_normals(coarse, facets)[1].sum(), rel=1e-12)
+    # no re-projection: the new foot vertices are chord midpoints, inside the circle
+    foot = np.unique(fine.facets[:, fine.boundaries["foot"]])
+    radius = np.hypot(fine.p[0, foot], fine.p[1, foot] - 1.0)
+    assert radius.max() == pytest.approx(1.0, abs=1e-12) and radius.min() < 1.0 - 1e-4
+
+
+# ---------------------------------------------------------------- curved sides
+
+
+@pytest.mark.parametrize("path, dim", [(HALF_DISC, 2), (CYLINDER, 3)])
+def test_nodal_normals_on_a_curved_side_are_radial(path, dim):
+    """On a polygonal arc of a circle the length-weighted mean of the facet
+    normals at a vertex is the radial direction up to O(h²)."""
+    problem = build_problem(scene_from_dict(file_scene(path, {
+        "contact.normal": law("compliance", c=1e3)}, dim=dim)))
+    b = problem.boundary
+    x = problem.mesh.p[:, b.nodes]
+    radial = x.copy()
+    radial[1] -= 1.0
+    if dim == 3:
+        radial[2] = 0.0
+        ends = (np.abs(x[2]) < 1e-12) | (np.abs(x[2] - 1.0) < 1e-12)
+    else:
+        ends = np.zeros(x.shape[1], bool)
+    radial /= np.linalg.norm(radial, axis=0)
+    angle = np.arccos(np.clip(np.sum(b.frame[:, :, 0].T * radial, axis=0), -1, 1))
+    h = 0.14 if dim == 2 else 0.47
+    assert angle[~ends].max() < 0.5 * h ** 2
+    # the frames are orthonormal
+    eye = np.einsum("aji,ajk->aik", b.frame, b.frame)
+    np.testing.assert_allclose(eye, np.broadcast_to(np.eye(dim), eye.shape), atol=1e-14)
+
+
+def test_patch_test_on_a_curved_file_mesh():
+    """u* linear and zero on the clamped top: the manufactured loads (tractions
+    σ* n on every other facet, with each facet's own normal) are reproduced
+    exactly by P1, on a mesh with a curved side, in 2D and 3D."""
+    for path, dim, u in [(HALF_DISC, 2, ["0.01*(y - 1)", "0.02*(1 - y)"]),
+                         (CYLINDER, 3, ["0.01*(y - 1)", "0.02*(1 - y)", "-0.01*(y - 1)"])]:
+        problem, solution = run(file_scene(path, {
+            "boundary.contact": DELETE, "exact.u": [f"t*({c})" for c in u]}, dim=dim))
+        p = problem.mesh.p
+        exact = problem.exact.displacement(*p, t=1.0) if dim == 3 else \
+            problem.exact.displacement(p[0], p[1], t=1.0)
+        np.testing.assert_allclose(solution.u[-1], exact.T, rtol=0, atol=1e-13)
+
+
+def test_file_rectangle_equals_the_builtin_rectangle(tmp_path):
+    """The built-in rectangle's triangles written to a .msh: the same run."""
+    changes = {"mesh.cells": [8, 2], "contact.normal": law("adhesive_compliance", c=1e4,
+                                                            gamma=100.0, L=0.01),
+               "contact.friction": [law("nonmonotone", a=2.0, b=1.0, alpha=50.0)],
+               "contact.gap": "0.002 + 0.001*x",
+               "contact.bonding": law("fremond", gamma_nu=100.0, gamma_tau=50.0,
+                                      eps_a=0.0, L=0.01),
+               "loads.body": ["100*t*x", "-300*t"], "time.steps": 3}
+    builtin = scene_dict(changes)
+    mesh = structured_mesh(scene_from_dict(builtin).mesh)
+    write_msh(tmp_path / "rect.msh", mesh, ["bottom", "top"])
+    on_file = scene_dict({**changes, "mesh": {"domain": "file", "file": "rect.msh"}})
+    a = build_problem(scene_from_dict(builtin))
+    b = build_problem(scene_from_dict(on_file, base_dir=tmp_path))
+    assert np.array_equal(a.mesh.p, b.mesh.p) and np.array_equal(a.mesh.t, b.mesh.t)
+    sa, sb = solve(a), solve(b)
+    assert sa.success and sb.success
+    np.testing.assert_allclose(sb.u, sa.u, rtol=0, atol=1e-12 * np.abs(sa.u).max())
+    np.testing.assert_allclose(sb.beta, sa.beta, rtol=0, atol=1e-12)
+
+
+# ---------------------------------------------------------------- the foundation
+
+
+def test_plane_foundation_on_a_flat_side_is_a_constant_gap():
+    changes = {"contact.normal": law("compliance", c=1e4), "loads.body": ["0", "-2000*t"]}
+    _, a = run(scene_dict({**changes, "contact.gap": 0.003}))
+    _, b = run(scene_dict({**changes, "contact.foundation": {
+        "point": [0.0, -0.003], "normal": [0.0, 2.0]}}))
+    assert a.success and b.success and (a.gap_violation() > -1e-12).any()
+    np.testing.assert_array_equal(b.problem.gap, a.problem.gap)
+    np.testing.assert_allclose(b.u, a.u, rtol=0, atol=1e-14)
+
+
+def test_foundation_gap_along_the_nodal_normal():
+    """Half-disc foot over a slanted plane and over a disc: the gap at each
+    node is the ray length along ν_a, checked against closed forms."""
+    base = {"contact.normal": law("compliance", c=1e3)}
+    n = np.array([0.2, 1.0]) / np.hypot(0.2, 1.0)
+    p = build_problem(scene_from_dict(file_scene(HALF_DISC, {**base, "contact.foundation": {
+        "point": [0.0, -0.1], "normal": list(n)}})))
+    x, nu = p.mesh.p[:, p.boundary.nodes], p.boundary.frame[:, :, 0].T
+    depth = (x - np.array([[0.0], [-0.1]])).T @ n
+    cos = -(nu.T @ n)
+    facing = cos > 1e-12
+    np.testing.assert_allclose(p.gap[0][facing], depth[facing] / cos[facing], rtol=1e-13)
+    assert np.isinf(p.gap[0][~facing]).all() and (~facing).any()
+    # a disc of radius 0.5 around (0, -0.6): the hit point lies on its circle
+    q = build_problem(scene_from_dict(file_scene(HALF_DISC, {**base, "contact.foundation": {
+        "shape": "sphere", "point": [0.0, -0.6], "radius": 0.5}})))
+    g = q.gap[0]
+    hit = np.isfinite(g)
+    y = x[:, hit] + g[hit] * nu[:, hit]
+    np.testing.assert_allclose(np.hypot(y[0], y[1] + 0.6), 0.5, rtol=1e-12)
+    assert g[hit].min() == pytest.approx(0.1, abs=2e-3) and hit.sum() < hit.size
+
+
+def test_cylinder_foundation_in_3d():
+    p = build_problem(scene_from_dict(file_scene(CYLINDER, {
+        "contact.normal": law("compliance", c=1e3), "contact.foundation": {
+            "shape": "cylinder", "point": [0.0, -2.0, 0.0], "axis": [0.0, 0.0, 1.0],
+            "radius": 1.9}}, dim=3)))
+    x, nu, g = p.mesh.p[:, p.boundary.nodes], p.boundary.frame[:, :, 0].T, p.gap[0]
+    hit = np.isfinite(g)
+    y = x[:, hit] + g[hit] * nu[:, hit]
+    np.testing.assert_allclose(np.hypot(y[0], y[1] + 2.0), 1.9, rtol=1e-12)
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"contact.gap": 0.1, "contact.foundation": {"point": [0, 0], "normal": [0, 1]}},
+     "contact.foundation: give exactly one of contact.gap"),
+    ({"contact.foundation": {"point": [0, 0], "normal": [0, 0]}},
+     "contact.foundation.normal: must be a nonzero vector"),
+    ({"contact.foundation": {"shape": "cylinder", "point": [0, 0], "radius": 1.0}},
+     "contact.foundation.shape: must be one of 'plane', 'sphere'"),
+    ({"contact.foundation": {"shape": "sphere", "point": [0, 0], "radius": -1.0}},
+     "contact.foundation.radius: must be > 0"),
+])
+def test_foundation_table_is_checked(changes, message):
+    with pytest.raises(SceneError, match="^" + message.replace("(", r"\(")):
+        scene_from_dict(scene_dict({"contact.normal": law("compliance", c=1.0), **changes}))
+
+
+def test_a_body_inside_the_foundation_is_refused():
+    with pytest.raises(SceneError, match=r"^contact\.foundation: the contact node \(.*\) "
+                                         "lies inside the foundation"):
+        build_problem(scene_from_dict(scene_dict({
+            "contact.normal": law("compliance", c=1.0),
+            "contact.foundation": {"point": [0.0, 0.1], "normal": [0.0, 1.0]}})))
+
+
+@pytest.mark.parametrize("path, dim", [(None, 3), (HALF_DISC, 2), (CYLINDER, 3)])
+def test_fine_contact_facets_find_their_coarse_facet(path, dim):
+    """Two refinements: each fine facet's centroid lies in its parent facet
+    (barycentric coordinates in [0, 1] and on its plane)."""
+    from adhesive_contact.verification import facet_parents, nested_meshes
+    if path is None:
+        spec = MeshSpec("box", (1.0, 0.5, 0.5), (2, 1, 1), dim=3)
+        side = "bottom"
+    else:
+        spec = scene_from_dict(file_scene(path, dim=dim)).mesh
+        side = "foot"
+    meshes = nested_meshes(spec, 2)
+    coarse, fine = meshes[0], meshes[-1]
+    cf, ff = coarse.boundaries[side], fine.boundaries[side]
+    parents = cf[facet_parents(meshes, cf, ff)]
+    centroid = fine.p[:, fine.facets[:, ff]].mean(axis=1)            # (d, n)
+    corners = coarse.p[:, coarse.facets[:, parents]]                  # (d, dim, n)
+    A = np.concatenate([corners, np.ones((1, dim, ff.size))]).transpose(2, 0, 1)
+    b = np.concatenate([centroid, np.ones((1, ff.size))]).T[:, :, None]
+    bary = np.array([np.linalg.lstsq(A[i], b[i], rcond=None)[0][:, 0] for i in range(ff.size)])
+    assert bary.min() > 0 and bary.max() < 1
+    recon = np.einsum("dvn,nv->dn", corners, bary)
+    np.testing.assert_allclose(recon, centroid, atol=1e-13)
