@@ -38,6 +38,14 @@ class ContactEnergy:
         self.friction = friction
         self.T = ([t[:, columns].tocsr() for t in boundary.tangential_trace]
                   if friction is not None else [])
+        if self.T:
+            # all tangential traces stacked (m·nq, nz), and the positions of
+            # the point blocks (i, j) of the friction Hessian in (m·nq)²
+            nq, m = self.w.size, len(self.T)
+            self.T_all = sp.vstack(self.T).tocsr()
+            q = np.arange(nq)
+            self.block_rows = (np.arange(m)[:, None, None] * nq + q).repeat(m, axis=1)
+            self.block_cols = (np.arange(m)[None, :, None] * nq + q).repeat(m, axis=0)
         self.nz = columns.size
         self.set_bonding(beta)
 
@@ -86,9 +94,12 @@ class ContactEnergy:
                 tang = np.where(s > 0, self.friction.dphi(self.beta, sf) / sf, 0.0)
                 blocks = (dd[:, None, None] * np.where(s[:, None, None] > 0, ee, np.eye(m))
                           + tang[:, None, None] * (np.eye(m) - ee))
-            for i, ti in enumerate(self.T):
-                for j, tj in enumerate(self.T):
-                    H = H + ti.T @ sp.diags(self.w * blocks[:, i, j]) @ tj
+            # Σ_ij T_iᵀ diag(w b_ij) T_j as one product T_allᵀ B T_all
+            n = m * self.w.size
+            B = sp.csr_matrix(((self.w[:, None, None] * blocks).transpose(1, 2, 0).ravel(),
+                               (self.block_rows.ravel(), self.block_cols.ravel())),
+                              shape=(n, n))
+            H = H + self.T_all.T @ B @ self.T_all
         return H.tocsr()
 
     def node_kink(self, nodes_of_points, n_nodes):

@@ -110,9 +110,9 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     def total(z):
         return 0.5 * z @ (S @ z) - c @ z + energy.value(z)
 
-    def noise(z):
+    def noise(z, Sz):
         # round-off of E: below it an energy comparison says nothing
-        return 1e-13 * (0.5 * abs(z @ (S @ z)) + abs(c @ z) + abs(energy.value(z)) + 1e-300)
+        return 1e-13 * (0.5 * abs(z @ Sz) + abs(c @ z) + abs(energy.value(z)) + 1e-300)
 
     z = np.minimum(z0, upper)
     E = total(z)
@@ -196,7 +196,7 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
 
         # the Newton direction, else (nonconvex energy, far from the
         # solution) the scaled projected gradient, which always descends
-        slack = noise(z)
+        slack = noise(z, Sz)
         gradient_step = -pg / np.where(diag_S > 0, diag_S, 1.0)
         if tan.size:
             gradient_step[tan[stuck]] = -xi[stuck]

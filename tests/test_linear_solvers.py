@@ -174,8 +174,11 @@ def test_auto_prefers_pardiso_then_superlu(system, monkeypatch):
     with pytest.raises(ValueError, match="method 'pardiso': pypardiso or MKL is not installed"):
         make_linear_solver(A, "pardiso", dim=dim)
     monkeypatch.setattr(pardiso, "available", lambda: True)
-    name, reason = choose(A.shape[0], A.nnz, dim)
+    name, reason = choose(10**5, 14 * 10**5, dim)
     assert name == "pardiso" and reason.startswith("MKL PARDISO is available")
+    # a small matrix goes to SuperLU all the same: PARDISO's first call loads MKL
+    name, reason = choose(A.shape[0], A.nnz, dim)
+    assert name == "superlu" and reason.startswith("the matrix is small")
 
 
 def test_auto_takes_amg_above_the_memory_limit(system):

@@ -48,6 +48,10 @@ FILL = {
 # was 9.3–14.6 bytes per entry of L from 1e4 dofs on)
 BYTES_PER_ENTRY = 12
 MEMORY_FRACTION = 0.5   # of physical memory, the default limit
+# below these sizes SuperLU sets up faster than PARDISO, whose first
+# factorisation in a process loads MKL (about 1 s here): at 1e4 dofs 0.74
+# against 1.66 s in 2D, 0.05 against 1.06 s at 1e3 in 3D (studies/bench/ladder.py)
+SMALL = {2: 30_000, 3: 5_000}
 
 
 def factor_bytes(n, nnz, dim, method):
@@ -89,7 +93,11 @@ def choose(n, nnz, dim, memory_limit=None):
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
     limit = default_memory_limit() if memory_limit is None else float(memory_limit)
-    if pardiso.available():
+    if pardiso.available() and n < SMALL[dim]:
+        direct, label, why = "superlu", "SuperLU", (
+            f"the matrix is small ({n} < {SMALL[dim]} dofs in {dim}D: SuperLU sets up faster "
+            "than PARDISO loads MKL)")
+    elif pardiso.available():
         direct, label, why = "pardiso", "PARDISO", "MKL PARDISO is available"
     else:
         direct, label, why = "superlu", "SuperLU", "PARDISO is not available here (no pypardiso or MKL)"

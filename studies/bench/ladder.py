@@ -1,0 +1,208 @@
+"""The cost of a run from 1e3 to 1e6 dofs: the benchmark of the solver.
+
+A ladder of scenes in 2D and 3D, frictionless (compliance and a wall) and
+the full model (memory, adhesive compliance, slip weakening and an
+adhesive spring, Frémond bonding, a wall), 20 steps each, for each linear
+backend asked for. Every case runs in its own process (so its peak memory
+is its own) and records:
+
+- ``dofs``, ``contact_unknowns``;
+- ``assembly`` (build_problem), ``setup`` (factorisation and Schur
+  complement), ``stepping`` and ``total`` seconds, ``per_step``;
+- ``solve_pair``: the linear work of one step alone (condensing the load
+  and expanding the interior: a forward and a backward solve with PARDISO's
+  partial factorisation, two solves with A_II otherwise), and
+  ``pairs_per_step`` = per_step / solve_pair: what a step costs in units of
+  its unavoidable linear work;
+- ``newton_per_step``; ``peak_mib``: the process's peak resident memory.
+
+It writes ``ladder.csv``, ``ladder.json`` (with the machine) and
+``ladder.png`` beside this script, and prints the fitted growth exponents
+of set-up and step time in the dofs.
+
+    python studies/bench/ladder.py [--max-dofs 1.1e6] [--backends auto,superlu,amg]
+
+Timings are wall-clock on whatever machine runs it (2 shared cores here):
+read them as orders of magnitude and as slopes.
+"""
+
+import argparse
+import csv
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+STEPS = 20
+
+# size parameter m -> cells; dofs ≈ 2 (8m+1)(m+1) in 2D, 3 (4m+1)(m+1)(2m+1) in 3D
+LADDER = {2: [8, 25, 80, 250], 3: [3, 7, 16]}
+
+GLUE = {
+    "normal": {"law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01},
+    "friction": [{"law": "nonmonotone", "a": 2.0, "b": 1.0, "alpha": 50.0},
+                 {"law": "adhesive_spring", "gamma": 2e3, "L": 0.01}],
+    "bonding": {"law": "fremond", "beta0": 1.0, "gamma_nu": 1e5, "gamma_tau": 5e4,
+                "eps_a": 0.0, "L": 0.01},
+}
+
+
+def scene(dim, m, model, backend):
+    """The scene document of one case."""
+    if dim == 2:
+        mesh = {"domain": "rectangle", "size": [4.0, 0.5], "cells": [8 * m, m]}
+        pull = ["7*t", "14*t"]
+    else:
+        mesh = {"domain": "box", "size": [4.0, 1.0, 2.0], "cells": [4 * m, m, 2 * m]}
+        pull = ["7*t", "14*t", "0"]
+    doc = {"title": f"ladder {dim}D {model}", "dim": dim, "mesh": mesh,
+           "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
+           "material": {"E": 1000.0, "nu": 0.3},
+           "time": {"T": 1.0, "steps": STEPS},
+           "solver": {"linear": backend}}
+    if model == "full":
+        doc["memory"] = {"kernel": "prony", "terms": [{"E": 200.0, "nu": 0.3, "tau": 0.5}]}
+        doc["loads"] = {"traction": {"right": pull}}
+        doc["contact"] = {"gap": 0.05, **GLUE}
+    else:   # pressed onto a compliant layer and a wall, no friction
+        doc["loads"] = {"body": ["0", "-40*t"] + (["0"] if dim == 3 else [])}
+        doc["contact"] = {"gap": 0.002, "normal": {"law": "compliance", "c": 1e4}}
+    return doc
+
+
+def run_case(doc):
+    """One case, in this process: the record of the module docstring."""
+    from adhesive_contact import build_problem, scene_from_dict, solve
+    from adhesive_contact.scheme.operators import StepOperators
+
+    t0 = time.perf_counter()
+    problem = build_problem(scene_from_dict(doc))
+    assembly = time.perf_counter() - t0
+    solution = solve(problem)
+    timings = solution.timings
+    # the linear work of one step, with the run's backend
+    memory = problem.start_memory()
+    step = StepOperators.build(problem, memory).step
+    b = np.random.default_rng(0).standard_normal(problem.free.size)
+    pairs = []
+    for _ in range(3):
+        t = time.perf_counter()
+        step.expand(step.reduce(b)[: step.contact.size] * 0.0, b)
+        pairs.append(time.perf_counter() - t)
+    per_step = timings["stepping"] / solution.t.size
+    return {
+        "dim": doc["dim"], "model": "full" if "memory" in doc else "frictionless",
+        "backend": solution.linear["method"], "dofs": int(problem.ndofs),
+        "contact_unknowns": int(problem.columns.size), "steps": STEPS,
+        "success": bool(solution.success),
+        "assembly": assembly, "setup": timings["factorisation"], "stepping": timings["stepping"],
+        "total": time.perf_counter() - t0, "per_step": per_step,
+        "solve_pair": float(np.median(pairs)),
+        "pairs_per_step": per_step / float(np.median(pairs)),
+        "newton_per_step": float(solution.iterations[1:].mean()) if solution.t.size > 1 else 0.0,
+        "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+    }
+
+
+def growth(rows, key):
+    """Least-squares exponent p of key ∝ dofs^p over the rows."""
+    if len(rows) < 2:
+        return None
+    x = np.log([r["dofs"] for r in rows])
+    y = np.log([max(r[key], 1e-9) for r in rows])
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def write(rows, exponents):
+    with open(HERE / "ladder.csv.tmp", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    os.replace(HERE / "ladder.csv.tmp", HERE / "ladder.csv")
+    machine = {"platform": platform.platform(), "processor": platform.processor(),
+               "cpus": os.cpu_count(), "python": platform.python_version()}
+    (HERE / "ladder.json.tmp").write_text(json.dumps(
+        {"machine": machine, "rows": rows, "growth": exponents}, indent=1))
+    os.replace(HERE / "ladder.json.tmp", HERE / "ladder.json")
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
+    for (dim, model, backend), group in _groups(rows).items():
+        dofs = [r["dofs"] for r in group]
+        label = f"{dim}D {model}, {backend}"
+        style = "o-" if model == "full" else "s--"
+        axes[0].loglog(dofs, [r["setup"] for r in group], style, label=label)
+        axes[1].loglog(dofs, [r["per_step"] for r in group], style, label=label)
+        axes[2].semilogx(dofs, [r["pairs_per_step"] for r in group], style, label=label)
+    for ax, title, ylabel in zip(axes, ["set-up (factorisation + Schur)", "one step",
+                                        "a step in solve pairs"],
+                                 ["seconds", "seconds", "per_step / solve pair"]):
+        ax.set(title=title, xlabel="dofs", ylabel=ylabel)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"ladder: {STEPS} steps per case, {machine['cpus']} cores")
+    fig.tight_layout()
+    fig.savefig(HERE / "ladder.tmp.png", dpi=110)
+    os.replace(HERE / "ladder.tmp.png", HERE / "ladder.png")
+
+
+def _groups(rows):
+    out = {}
+    for r in rows:
+        out.setdefault((r["dim"], r["model"], r["backend"]), []).append(r)
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--max-dofs", type=float, default=1.1e6)
+    parser.add_argument("--backends", default="auto")
+    parser.add_argument("--case", help=argparse.SUPPRESS)   # one case, in a child process
+    args = parser.parse_args()
+    if args.case:
+        print(json.dumps(run_case(json.loads(args.case))))
+        return
+    rows = []
+    for dim, sizes in LADDER.items():
+        for model in ("frictionless", "full"):
+            for backend in args.backends.split(","):
+                for m in sizes:
+                    dofs = 2 * (8 * m + 1) * (m + 1) if dim == 2 else \
+                        3 * (4 * m + 1) * (m + 1) * (2 * m + 1)
+                    if dofs > args.max_dofs:
+                        continue
+                    case = json.dumps(scene(dim, m, model, backend))
+                    done = subprocess.run([sys.executable, __file__, "--case", case],
+                                          capture_output=True, text=True)
+                    if done.returncode:
+                        print(f"{dim}D {model} {backend} m={m}: failed\n{done.stderr[-2000:]}")
+                        continue
+                    row = json.loads(done.stdout.splitlines()[-1])
+                    rows.append(row)
+                    print(f"{dim}D {model:12s} {row['backend']:8s} {row['dofs']:8d} dofs, "
+                          f"{row['contact_unknowns']:5d} on Γ_C: set-up {row['setup']:7.2f} s, "
+                          f"{1e3 * row['per_step']:8.1f} ms/step = "
+                          f"{row['pairs_per_step']:5.1f} solve pairs, "
+                          f"{row['newton_per_step']:4.1f} Newton/step, total {row['total']:7.1f} s,"
+                          f" peak {row['peak_mib']:6.0f} MiB", flush=True)
+    exponents = {f"{dim}D {model} {backend}": {"setup": growth(g, "setup"),
+                                               "per_step": growth(g, "per_step")}
+                 for (dim, model, backend), g in _groups(rows).items()}
+    for name, e in exponents.items():
+        if e["setup"] is not None:
+            print(f"growth in dofs, {name}: set-up ~ n^{e['setup']:.2f}, "
+                  f"step ~ n^{e['per_step']:.2f}")
+    write(rows, exponents)
+
+
+if __name__ == "__main__":
+    main()
