@@ -334,6 +334,14 @@ class Fremond:
         b = np.clip(beta, 0.0, 1.0)
         return -np.maximum(b * self.stretch(r, xi) - self.eps_a, 0.0)
 
+    def rate_derivative(self, r, xi, beta):
+        """∂F/∂β = −stretch where the glue is loaded (β stretch > ε_a) and
+        0 ≤ β ≤ 1, else 0 (one element of the generalised derivative)."""
+        stretch = self.stretch(r, xi)
+        b = np.clip(beta, 0.0, 1.0)
+        loaded = (b * stretch > self.eps_a) & (beta >= 0.0) & (beta <= 1.0)
+        return np.where(loaded, -stretch, 0.0)
+
     def stable_step(self):
         """The largest k with β_n ≥ 0 guaranteed for explicit Euler:
         k (γ_ν + γ_τ) L² ≤ 1 (β_n ≥ β_{n−1}(1 − k max stretch))."""
