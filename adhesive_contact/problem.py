@@ -84,7 +84,8 @@ class Problem:
             out.append(f"smallness condition of MODEL.md §2 does not hold: m_A = "
                        f"{s['m_A']:.4g} <= (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}; uniqueness "
                        f"is not guaranteed by the theory; {tail}")
-        if self.bonding is not None and self.scene.k > self.bonding.stable_step():
+        if (self.bonding is not None and self.scene.contact.integrator == "explicit"
+                and self.scene.k > self.bonding.stable_step()):
             out.append(f"time step k = {self.scene.k:.4g} exceeds the explicit Euler bound "
                        f"1/((gamma_nu + gamma_tau) L^2) = {self.bonding.stable_step():.4g} of "
                        f"the bonding law: beta may overshoot below 0; use more steps")
