@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1
 
+from .admissibility import check_manufactured
 from .assembly import Assembly, LoadMap, is_zero, vector_of
 from .contact_boundary import (
     build_contact_boundary,
@@ -189,6 +190,9 @@ def build_problem(scene):
                    for side, exprs in scene.traction.items()]
     else:
         exact = ManufacturedSolution(scene, normal_law, friction, bonding)
+        check_manufactured(scene, mesh, exact, times, scene.contact.gap,
+                           lambda side: _side_normal(side, d),
+                           lambda side: tangent_frame(_side_normal(side, d)[:, None])[0, :, 1:].T)
         body = exact.body_force
         neumann = [s for s in SIDES[d] if s not in scene.dirichlet + scene.contact_sides]
         surface = [(mesh.boundaries[side], exact.traction(_side_normal(side, d)[:, None]))
