@@ -32,12 +32,14 @@ WALL_SLACK = 1e-10
 class InvalidState(StepFailure):
     """A level that converged to values the model does not allow."""
 
-    def __init__(self, n, t, reason):
-        self.n, self.t, self.result, self.reason = n, t, None, reason
+    def __init__(self, n, t, reason, result=None):
+        # result: the step solve's StepResult (it converged), None for a
+        # failure found before the solve
+        self.n, self.t, self.result, self.reason = n, t, result, reason
         RuntimeError.__init__(self, f"step {n} (t = {t:g}) gave an invalid state: {reason}")
 
     def __reduce__(self):
-        return (type(self), (self.n, self.t, self.reason))
+        return (type(self), (self.n, self.t, self.reason, self.result))
 
 
 def _where(problem, facet):

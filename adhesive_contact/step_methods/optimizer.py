@@ -12,7 +12,8 @@ its iterates hover around the kink and its line search usually gives up.
 Whatever L-BFGS-B says, the result is judged by the same pseudo-gradient
 as "newton" (:func:`~.base.stationarity`): converged only if it is below
 ``tol`` times the force scale of the step, else OPTIMIZER_STOPPED with
-L-BFGS-B's own message. It runs at most ``OPTIMIZER_ITERATIONS ·
+L-BFGS-B's own message. L-BFGS-B itself stops when its projected gradient
+is below ``tol`` times the force scale of the starting point. It runs at most ``OPTIMIZER_ITERATIONS ·
 max_iter`` iterations (one energy and gradient evaluation each, plus the
 line search's).
 """
@@ -54,10 +55,13 @@ def minimise(S, c, energy, upper, z0, options, kink=None):
 
     bounds = [(None, None if not np.isfinite(b) else float(b)) for b in upper]
     z_start = np.minimum(z0, upper)
+    # L-BFGS-B's own stop: its projected gradient below tol times the force
+    # scale of the start (the pseudo-gradient judges the result afterwards)
+    start = stationarity(S, c, energy, upper, z_start, kink)
     out = minimize(fun, z_start, jac=True, method="L-BFGS-B", bounds=bounds,
                    options={"maxiter": OPTIMIZER_ITERATIONS * options.max_iter,
                             "maxfun": 2 * OPTIMIZER_ITERATIONS * options.max_iter,
-                            "ftol": 0.0, "gtol": 0.0, "maxcor": 20})
+                            "ftol": 0.0, "gtol": options.tol * start.scale, "maxcor": 20})
     z = np.minimum(out.x, upper)
     st = stationarity(S, c, energy, upper, z, kink)
     if st.residual <= options.tol * st.scale:
