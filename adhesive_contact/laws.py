@@ -15,7 +15,8 @@ and give φ, φ' = ∂_s φ, φ'' and ``kink(beta)`` = φ'(β, 0+) ≥ 0: the Cl
 subdifferential of j_τ(β, ·) at ξ = 0 is the ball of that radius (the
 friction bound), and ∇j_τ = φ'(|ξ|) ξ/|ξ| elsewhere. The class attribute
 ``has_kink`` says whether φ'(β, 0+) can be > 0 (a law with a kink needs the
-nodal rule on Γ_C); ``m_tau`` is m_τ, the constant of the relaxed
+nodal rule on Γ_C); ``c_1`` is c_1τ of the growth bound |∂j_τ| ≤ c_0 +
+c_1 (|β| + |ξ|) (0 for a bounded ∂j_τ); ``m_tau`` is m_τ, the constant of the relaxed
 monotonicity (∇j_τ(β₁, ξ₁) − ∇j_τ(β₂, ξ₂))·(ξ₁ − ξ₂) ≥ −m_τ (|β₁ − β₂| +
 |ξ₁ − ξ₂|) |ξ₁ − ξ₂|.
 
@@ -138,6 +139,7 @@ class Tresca:
     mu: float
     has_kink = True
     m_tau = 0.0
+    c_1 = 0.0          # |∂j_τ| ≤ μ: bounded
 
     def kink(self, beta):
         return np.full(np.shape(beta), float(self.mu))
@@ -163,6 +165,7 @@ class SlipWeakening:
     b: float
     alpha: float
     has_kink = True
+    c_1 = 0.0          # |∂j_τ| ≤ a: bounded
 
     @property
     def m_tau(self):
@@ -201,6 +204,11 @@ class PowerLaw:
     has_kink = False
     m_tau = 0.0
 
+    @property
+    def c_1(self):
+        """|∂j_τ| = μ s^q ≤ μ (1 + s): c_0 = c_1 = μ."""
+        return self.mu
+
     @staticmethod
     def check(params):
         if not 0.0 < params["q"] <= 1.0:
@@ -233,6 +241,7 @@ class AdhesiveSpring:
     gamma: float
     L: float
     has_kink = False
+    c_1 = 0.0          # |∂j_τ| ≤ γ L: bounded
 
     @property
     def m_tau(self):
@@ -262,6 +271,11 @@ class FrictionSum:
     def m_tau(self):
         """m_τ of the sum: the sum of the m_τ of its laws."""
         return sum(law.m_tau for law in self.laws)
+
+    @property
+    def c_1(self):
+        """c_1 of the growth bound |∂j_τ| ≤ c_0 + c_1 (|β| + |ξ|) of the sum."""
+        return sum(law.c_1 for law in self.laws)
 
     @property
     def nonconvexity(self):
@@ -333,6 +347,14 @@ class Fremond:
         """F(r, ξ, β)."""
         b = np.clip(beta, 0.0, 1.0)
         return -np.maximum(b * self.stretch(r, xi) - self.eps_a, 0.0)
+
+    def rate_derivative(self, r, xi, beta):
+        """∂F/∂β = −stretch where the glue is loaded (β stretch > ε_a) and
+        0 ≤ β ≤ 1, else 0 (one element of the generalised derivative)."""
+        stretch = self.stretch(r, xi)
+        b = np.clip(beta, 0.0, 1.0)
+        loaded = (b * stretch > self.eps_a) & (beta >= 0.0) & (beta <= 1.0)
+        return np.where(loaded, -stretch, 0.0)
 
     def stable_step(self):
         """The largest k with β_n ≥ 0 guaranteed for explicit Euler:

@@ -25,6 +25,7 @@ from functools import partial
 
 import numpy as np
 
+from .admissibility import on_wall
 from .expressions import FUNCTIONS
 
 _GAUSS_POINTS = 16   # Gauss–Legendre points in s for the memory integral (exact to
@@ -151,6 +152,15 @@ class ManufacturedSolution:
     def beta(self, x, y=None, z=None, t=0.0):
         return np.asarray(self._beta(x, y, z, t), dtype=float)
 
+    @property
+    def has_multiplier(self):
+        """Whether the scene gives a wall multiplier λ*."""
+        return self._multiplier is not None
+
+    def multiplier(self, x, y=None, z=None, t=0.0):
+        """λ*(x, t) (call only if :attr:`has_multiplier`)."""
+        return np.asarray(self._multiplier(x, y, z, t), dtype=float)
+
     # -- memory: ∫_0^t kernel(t − s) g(s) ds by Gauss–Legendre in s ------
 
     def _history(self, g, x, y, z, t):
@@ -221,8 +231,7 @@ class ManufacturedSolution:
         push = self.normal_law.value(beta, r)
         if self.gap is not None and self._multiplier is not None:
             g = self.gap(x, y, z, t=t)
-            on_wall = np.abs(r - g) <= 1e-12 * (1.0 + np.abs(g))
-            push = push + np.where(on_wall, self._multiplier(x, y, z, t), 0.0)
+            push = push + np.where(on_wall(r, g), self._multiplier(x, y, z, t), 0.0)
         load = sig_n + push * normal
         if self.friction is not None:
             force = self.friction.gradient(beta, xi)    # 0 where ξ = 0

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1, FacetBasis
 
+from .admissibility import check_manufactured
 from .assembly import LOAD_INTORDER, Assembly, LoadMap, is_zero, vector_element, vector_of
 from .contact_boundary import (
     build_contact_boundary,
@@ -85,7 +86,8 @@ class Problem:
             out.append(f"smallness condition of MODEL.md §2 does not hold: m_A = "
                        f"{s['m_A']:.4g} <= (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}; uniqueness "
                        f"is not guaranteed by the theory; {tail}")
-        if self.bonding is not None and self.scene.k > self.bonding.stable_step():
+        if (self.bonding is not None and self.scene.contact.integrator == "explicit"
+                and self.scene.k > self.bonding.stable_step()):
             out.append(f"time step k = {self.scene.k:.4g} exceeds the explicit Euler bound "
                        f"1/((gamma_nu + gamma_tau) L^2) = {self.bonding.stable_step():.4g} of "
                        f"the bonding law: beta may overshoot below 0; use more steps")
@@ -182,6 +184,8 @@ def build_problem(scene):
                    for side, exprs in scene.traction.items()]
     else:
         exact = ManufacturedSolution(scene, normal_law, friction, bonding)
+        check_manufactured(scene, mesh, exact, times, scene.contact.gap, dirichlet_facets,
+                           contact_facets)
         body = exact.body_force
         neumann = np.setdiff1d(mesh.boundary_facets(),
                                np.concatenate([dirichlet_facets, contact_facets]))

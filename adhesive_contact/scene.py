@@ -25,10 +25,12 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .bonding import INTEGRATORS
 from .expressions import ExpressionError, compile_expression
 from .laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
 from .linear_solvers import METHODS
 from .linear_solvers.pardiso import available as pardiso_available
+from .step_methods import METHODS as STEP_METHODS
 
 
 class SceneError(ValueError):
@@ -163,10 +165,23 @@ class ExactSpec:
 
 @dataclass(frozen=True)
 class SolverSpec:
+    """The ``[solver]`` table.
+
+    ``method`` the step method (:mod:`adhesive_contact.step_methods`);
+    ``penalty`` and ``smoothing`` are read by ``method = "penalty"`` only:
+    the wall's penalty stiffness is ρ = penalty · max_i S_ii (the largest
+    diagonal entry of the step's condensed matrix), so the wall violation
+    it leaves is about 1/penalty of the displacement a unit contact force
+    causes; the friction kink is rounded over δ = smoothing · the diameter
+    of the body.
+    """
+
     method: str = "newton"
     tol: float = 1e-10
     max_iter: int = 50
     linear: str = "auto"          # the linear backend (adhesive_contact.linear_solvers)
+    penalty: float = 1e4          # relative to max diag S
+    smoothing: float = 1e-6       # relative to the diameter of the body
 
 
 @dataclass(frozen=True)
@@ -217,8 +232,7 @@ class Scene:
                       "traction": {side: _texts(v) for side, v in self.traction.items()}},
             "contact": _contact_record(self.contact),
             "time": {"T": self.T, "steps": self.steps, "k": self.k},
-            "solver": {"method": self.solver.method, "tol": self.solver.tol,
-                       "max_iter": self.solver.max_iter, "linear": self.solver.linear},
+            "solver": _solver_record(self.solver),
             "output": {"probes": [list(p) for p in self.probes]},
             "exact": _exact_record(self.exact),
         }
@@ -282,6 +296,14 @@ def _contact_record(contact):
     if contact.bonded:
         record["integrator"] = contact.integrator
     record["bonding"] = _law_record(contact.bonding)
+    return record
+
+
+def _solver_record(solver):
+    record = {"method": solver.method, "tol": solver.tol, "max_iter": solver.max_iter,
+              "linear": solver.linear}
+    if solver.method == "penalty":
+        record.update(penalty=solver.penalty, smoothing=solver.smoothing)
     return record
 
 
@@ -611,7 +633,7 @@ def _read_bonding(table, dim):
         if beta0.is_constant and not 0.0 <= float(beta0(0.0)) <= 1.0:
             raise SceneError(table.key("beta0"), f"must lie in [0, 1], got {source}")
     integrator = _choice(table.key("integrator"),
-                         table.get("integrator", "str", "explicit"), ("explicit",))
+                         table.get("integrator", "str", "explicit"), tuple(INTEGRATORS))
     table.finish()
     return bonding, beta0, integrator
 
@@ -693,7 +715,7 @@ def _read_solver(table):
     """A SolverSpec; ``SolverSpec()`` without a [solver] table."""
     if table is None:
         return SolverSpec()
-    method = _choice("solver.method", table.get("method", "str", "newton"), ("newton",))
+    method = _choice("solver.method", table.get("method", "str", "newton"), tuple(STEP_METHODS))
     tol = _positive("solver.tol", table.get("tol", "number", 1e-10))
     max_iter = table.get("max_iter", "int", 50)
     if max_iter < 1:
@@ -702,8 +724,11 @@ def _read_solver(table):
     if linear == "pardiso" and not pardiso_available():
         raise SceneError("solver.linear", "'pardiso' needs pypardiso and MKL, which are not "
                          "installed here; allowed are auto, superlu, amg")
+    penalty = _positive("solver.penalty", table.get("penalty", "number", SolverSpec.penalty))
+    smoothing = _positive("solver.smoothing",
+                          table.get("smoothing", "number", SolverSpec.smoothing))
     table.finish()
-    return SolverSpec(method, tol, max_iter, linear)
+    return SolverSpec(method, tol, max_iter, linear, penalty, smoothing)
 
 
 def _read_probes(table, dim):

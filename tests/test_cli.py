@@ -29,7 +29,9 @@ STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "be
              "iterations", "residual"}
 SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "linear",
                 "iterations", "steps"}
-SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds",
+SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
+                  "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",
+                  "trace_lower_estimate",
                   "nonconvexity", "step_energy_convex"}
 FILES = {"summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
          "contact.h5", "deformed.png", "contact_traction.png", "beta.png"}
@@ -457,8 +459,9 @@ def test_glued_summary_reports_the_smallness_terms(glued):
     assert set(summary) == SUMMARY_KEYS
     small = summary["smallness"]
     assert set(small) == SMALLNESS_KEYS
-    assert isinstance(small["holds"], bool) and isinstance(small["step_energy_convex"], bool)
-    for key in SMALLNESS_KEYS - {"holds", "step_energy_convex"}:
+    flags = {"holds", "step_energy_convex", "existence_holds", "trace_lower_estimate"}
+    assert all(isinstance(small[key], bool) for key in flags)
+    for key in SMALLNESS_KEYS - flags:
         assert isinstance(small[key], float), key
     # what the library estimates, passed through unchanged (its formulas are
     # tested with the library); m_A = min(2 mu, d lam + 2 mu) checked here
@@ -473,6 +476,9 @@ def test_glued_summary_reports_the_smallness_terms(glued):
     assert small["rhs"] == pytest.approx(
         (small["m_tau"] + small["m_nu"]) * small["trace_constant_squared"])
     assert small["holds"] is (small["m_A"] > small["rhs"])
+    # existence: max{√3 c_1τ, m_τ} + m_ν (c_1τ = 0: bounded friction here)
+    assert small["c_1tau"] == 0.0 and small["existence_rhs"] == pytest.approx(small["rhs"])
+    assert small["trace_lower_estimate"] is False   # the run's own mesh
 
 
 def test_glued_warnings_are_listed_and_printed_before_stepping(glued):

@@ -11,7 +11,10 @@ and after each level that
   source s_β breaks the invariance of [0, 1] (F ≥ 0 for β ≤ 0, F ≤ 0 for
   β ≥ 1), so a coarse k may leave it by the discretisation error alone;
 - u_ν ≤ g at the contact nodes up to round-off (``WALL_SLACK`` relative to
-  the size of g and u_ν): the step solve projects onto the wall exactly.
+  the size of g and u_ν): the exact step methods project onto the wall.
+  Not for ``solver.method = "penalty"``, which solves a nearby problem
+  and leaves a violation by design; it is recorded
+  (:meth:`~.solution.Solution.gap_violation`, :func:`wall_record`) instead.
 
 A violation stops the run with :class:`InvalidState`, one paragraph that
 says what failed, where, the figures and what to try.
@@ -19,6 +22,7 @@ says what failed, where, the figures and what to try.
 
 import numpy as np
 
+from ..step_methods import EXACT
 from .solution import StepFailure
 
 BETA_SLACK = 1e-12
@@ -28,12 +32,14 @@ WALL_SLACK = 1e-10
 class InvalidState(StepFailure):
     """A level that converged to values the model does not allow."""
 
-    def __init__(self, n, t, reason):
-        self.n, self.t, self.result, self.reason = n, t, None, reason
+    def __init__(self, n, t, reason, result=None):
+        # result: the step solve's StepResult (it converged), None for a
+        # failure found before the solve
+        self.n, self.t, self.result, self.reason = n, t, result, reason
         RuntimeError.__init__(self, f"step {n} (t = {t:g}) gave an invalid state: {reason}")
 
     def __reduce__(self):
-        return (type(self), (self.n, self.t, self.reason))
+        return (type(self), (self.n, self.t, self.reason, self.result))
 
 
 def _where(problem, facet):
@@ -63,17 +69,19 @@ def check_level(problem, level):
         reason = (f"beta = {beta[facet]:.4g} leaves [0, 1] on the contact facet at "
                   f"{_where(problem, facet)}")
         bonding = problem.bonding
-        if bonding is not None:
+        if bonding is not None and problem.scene.contact.integrator == "explicit":
             k, bound = problem.scene.k, bonding.stable_step()
             reason += (f". The explicit Euler step of the bonding law keeps beta in [0, 1] "
                        f"only for k (gamma_nu + gamma_tau) L^2 <= 1, i.e. k <= {bound:.4g}; "
                        f"this run has k = {k:.4g}")
             if k > bound:
                 need = int(np.ceil(problem.scene.T / bound))
-                reason += f". Use at least time.steps = {need}"
+                reason += (f". Use at least time.steps = {need}, or "
+                           f"contact.bonding.integrator = 'exponential' or 'implicit'")
         return InvalidState(n, t, reason)
     gap = problem.gap
-    if gap is not None and level.frame_displacement.shape[0]:
+    exact = problem.scene.solver.method in EXACT
+    if exact and gap is not None and level.frame_displacement.shape[0]:
         u_nu = level.frame_displacement[:, 0]
         excess = u_nu - gap[n]
         worst = int(np.argmax(excess))
@@ -85,3 +93,20 @@ def check_level(problem, level):
                 f"u_nu - g = {excess[worst]:.3g} > 0 at the contact node "
                 f"({', '.join(f'{c:.4g}' for c in x)}): the rigid wall is crossed"))
     return None
+
+
+def wall_record(solution):
+    """How far a run crossed the wall: ``{"method", "exact", "max_violation",
+    "max_relative_violation"}``, the largest u_ν − g over the levels (0 when
+    never crossed, None without a wall), and relative to max |u_ν|. The
+    exact step methods leave round-off; "penalty" leaves about λ/ρ."""
+    method = solution.problem.scene.solver.method
+    out = {"method": method, "exact": method in EXACT, "max_violation": None,
+           "max_relative_violation": None}
+    violation = solution.gap_violation()
+    if solution.problem.gap is None or not np.all(np.isfinite(violation)):
+        return out
+    worst = max(float(violation.max(initial=0.0)), 0.0)
+    size = float(np.abs(solution.normal_displacement).max(initial=0.0))
+    out.update(max_violation=worst, max_relative_violation=worst / size if size > 0 else 0.0)
+    return out

@@ -77,6 +77,8 @@ def march(problem, operators, contact, recorder, state, progress=None):
                                                       beta, history, state.z)   # (4.1)
             failure = StepFailure(n, t, result) if level is None else check_level(problem,
                                                                                   level)
+            if failure is not None and failure.result is None:
+                failure.result = result   # an invalid state: the solve that gave it
         if failure is not None:
             return STEP_FAILED, failure, state
         recorder.record(level)

@@ -11,9 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..bonding import FacetRate, advance
 from ..contact_energy import ContactEnergy
 from ..expressions import coordinates
-from ..step_solver import Kink, minimise_step
+from ..step_methods import Kink, StepOptions, minimise
 
 
 @dataclass
@@ -50,7 +51,8 @@ class Level:
 
 class ContactStep:
     """The contact terms Φ of a run's steps and the kinks of its friction
-    (:mod:`adhesive_contact.contact_energy`, :mod:`adhesive_contact.step_solver`)."""
+    (:mod:`adhesive_contact.contact_energy`), solved by the scene's step
+    method (:mod:`adhesive_contact.step_methods`)."""
 
     def __init__(self, problem):
         boundary, nc, d = problem.boundary, problem.boundary.nodes.size, problem.dim
@@ -65,15 +67,28 @@ class ContactStep:
             self.kink = Kink(tangential, np.zeros(nc))
 
     def minimise(self, S, c, beta, n, z0):
-        """The step solve of (4.1) on the contact unknowns with β_n."""
+        """The step solve of (4.1) on the contact unknowns with β_n, by
+        ``solver.method``."""
         problem = self.problem
         self.energy.set_bonding(beta)
         if self.kink is not None:
             self.kink.radius = self.energy.node_kink(problem.boundary.point_node,
                                                      problem.boundary.nodes.size)
         solver = problem.scene.solver
-        return minimise_step(S, c, self.energy, problem.upper_bound(n), z0,
-                             solver.tol, solver.max_iter, self.kink)
+        return minimise(solver.method, S, c, self.energy, problem.upper_bound(n), z0,
+                        self.options(S), self.kink)
+
+    def options(self, S):
+        """The StepOptions of a step with matrix S: the scene's tolerances and,
+        for "penalty", ρ = penalty · max_i S_ii and δ = smoothing · diam Ω."""
+        solver = self.problem.scene.solver
+        if solver.method != "penalty":
+            return StepOptions(solver.tol, solver.max_iter)
+        p = self.problem.mesh.p
+        diameter = float(np.linalg.norm(p.max(axis=1) - p.min(axis=1)))
+        stiffness = float(np.max(S.diagonal(), initial=0.0))
+        return StepOptions(solver.tol, solver.max_iter, solver.penalty * stiffness,
+                           solver.smoothing * diameter)
 
 
 def initial_state(problem, memory):
@@ -86,7 +101,9 @@ def initial_state(problem, memory):
 
 
 def bonding_step(problem, state):
-    """(4.2): β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
+    """(4.2): β_n from β_{n−1} and u_{n−1} by the scene's integrator
+    (:mod:`adhesive_contact.bonding`); explicit Euler, the paper's, is
+    β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
     without a bonding law, and at n = 0)."""
     if problem.bonding is None or state.n < 0:
         return state.beta
@@ -94,10 +111,11 @@ def bonding_step(problem, state):
     r = boundary.normal_trace @ state.frame_u
     xi = (np.stack([t @ state.frame_u for t in boundary.tangential_trace], axis=-1)
           if boundary.tangential_trace else None)
-    rate = problem.bonding.rate(r, xi, boundary.at_points(state.beta))
+    source = None
     if problem.beta_source is not None:   # manufactured solutions only
-        rate = rate + problem.beta_source(*coordinates(boundary.points), t=state.t)
-    return state.beta + problem.scene.k * boundary.facet_mean(rate)
+        source = problem.beta_source(*coordinates(boundary.points), t=state.t)
+    rate = FacetRate(problem.bonding, r, xi, boundary.at_points, boundary.facet_mean, source)
+    return advance(problem.scene.contact.integrator, rate, state.beta, problem.scene.k)
 
 
 def step_load(problem, operators, state, n, t):
@@ -117,7 +135,7 @@ def step_solve(problem, operators, contact, n, t, b, beta, history, z0):
     σ_n = C ε(u_n) + k R(0) ε(u_n) + history and the contact reactions.
 
     Returns ``(level, u, frame_u, z, result)``; ``result`` is the
-    :class:`~adhesive_contact.step_solver.StepResult` (None without Γ_C)."""
+    :class:`~adhesive_contact.step_methods.StepResult` (None without Γ_C)."""
     step = operators.at(n)
     c = step.reduce(b)
     d = problem.dim

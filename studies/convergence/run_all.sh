@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 out=results
 jobs=${JOBS:-2}
-for case in a_separated_slipping b_wall_multiplier c_stick_slip d_uneven_debonding; do
+for case in a_separated_slipping a50_separated_slipping_small b_wall_multiplier c_stick_slip d_uneven_debonding; do
     steps_h=256
     [ "$case" = d_uneven_debonding ] && steps_h=2048
     adhcontact converge "$case.toml" --param h --levels 5 --steps "$steps_h" --jobs "$jobs" --out "$out/$case-h"

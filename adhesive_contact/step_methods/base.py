@@ -1,0 +1,142 @@
+"""The interface of the step methods: their options, what they return,
+and the one measure of stationarity they are all judged by.
+
+A step of (4.1), with the interior condensed out, minimises
+
+    E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z ≤ upper  (the wall),
+
+Φ the contact terms (:class:`~adhesive_contact.contact_energy.ContactEnergy`),
+whose friction adds at each node a with a kink the Clarke subdifferential
+B(0, κ_a) at ξ_a = 0. z is stationary when 0 ∈ ∂E(z) + N_wall(z): the
+*pseudo-gradient* (the minimal-norm element of that set, :func:`stationarity`)
+vanishes. Its sup norm over the force scale of the step is the residual
+every exact method reports.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: StepResult.status: how a step solve ended
+CONVERGED, MAX_ITERATIONS, LINE_SEARCH_FAILED, DIVERGED, OPTIMIZER_STOPPED = 0, 1, 2, 3, 4
+MESSAGES = {CONVERGED: "converged",
+            MAX_ITERATIONS: "no convergence in {max_iter} iterations",
+            LINE_SEARCH_FAILED: "line search failed: no decrease of the energy along the "
+                                "Newton or the gradient direction",
+            DIVERGED: "the iterates diverged (energy or iterate not finite, or growing "
+                      "without bound) after {nit} full Newton steps",
+            OPTIMIZER_STOPPED: "the bound-constrained minimiser stopped short of the "
+                               "tolerance ({detail})"}
+
+
+@dataclass
+class StepResult:
+    """How a step solve ended (cf. scipy.optimize.OptimizeResult).
+
+    ``status`` is one of :data:`CONVERGED`, :data:`MAX_ITERATIONS`,
+    :data:`LINE_SEARCH_FAILED`, :data:`DIVERGED`, :data:`OPTIMIZER_STOPPED`;
+    ``residual`` the relative residual reached (the pseudo-gradient for the
+    exact methods, the gradient of the penalised energy for "penalty");
+    ``inner_failures`` the Newton systems whose iterative solve (CG, for an
+    applied Schur complement) stopped before its tolerance;
+    ``wall_violation`` max (z_ν − g)_+ the method left (0 for the exact
+    methods, which project onto the wall)."""
+
+    z: np.ndarray
+    status: int
+    message: str
+    nit: int
+    residual: float
+    tolerance: float
+    energy: float
+    inner_failures: int = 0
+    multiplier: np.ndarray = field(default=None, repr=False)  # wall reaction λ ≥ 0 per unknown
+    on_wall: np.ndarray = field(default=None, repr=False)     # bool per unknown
+    stuck: np.ndarray = field(default=None, repr=False)       # bool per node with a kink (ξ_a = 0)
+    wall_violation: float = 0.0
+
+    @property
+    def success(self):
+        return self.status == CONVERGED
+
+
+@dataclass(frozen=True)
+class StepOptions:
+    """What a step method is told (from the scene's ``[solver]`` table).
+
+    ``tol`` the relative tolerance on the residual; ``max_iter`` the Newton
+    iterations (the optimizer gets ``OPTIMIZER_ITERATIONS`` times as many:
+    a quasi-Newton step is cheaper and slower); ``penalty`` ρ, the wall's
+    penalty stiffness per contact unknown, and ``smoothing`` δ, the length
+    below which the friction kink is rounded (both for "penalty" only, in
+    absolute units, scaled by the caller)."""
+
+    tol: float = 1e-10
+    max_iter: int = 50
+    penalty: float = None
+    smoothing: float = None
+
+
+#: L-BFGS-B iterations per ``max_iter``
+OPTIMIZER_ITERATIONS = 100
+
+
+@dataclass
+class Kink:
+    """The nodes whose friction has a kink: their tangential unknowns and κ_a."""
+
+    tangential: np.ndarray   # (na, m) indices into z
+    radius: np.ndarray       # (na,) κ_a ≥ 0
+
+
+def no_kink():
+    """The Kink of a problem without friction."""
+    return Kink(np.zeros((0, 1), dtype=np.int64), np.zeros(0))
+
+
+@dataclass
+class Stationarity:
+    """The first-order quantities of E at z (see :func:`stationarity`)."""
+
+    g: np.ndarray          # ∇E where E is differentiable (the kink left out)
+    Sz: np.ndarray         # S z (its quadratic part, kept for the energy's round-off)
+    xi: np.ndarray         # (na, m) ξ_a at the nodes with a kink
+    s: np.ndarray          # (na,) |ξ_a|
+    at_zero: np.ndarray    # (na,) ξ_a = 0
+    unit: np.ndarray       # (na, m) ξ_a/|ξ_a|, 0 at ξ_a = 0
+    h: np.ndarray          # (na, m) the tangential gradient without the kink
+    hn: np.ndarray         # (na,) |h_a|
+    pg: np.ndarray         # the pseudo-gradient
+    wall: np.ndarray       # bool: on the wall and pressed onto it
+    scale: float           # the force scale of the step
+    residual: float        # |pg|_∞ (absolute)
+
+    @property
+    def relative(self):
+        return self.residual / self.scale
+
+
+def stationarity(S, c, energy, upper, z, kink):
+    """The pseudo-gradient of E at z: the minimal-norm element of
+    ∂E(z) + N_wall(z), with ∂E the Clarke subdifferential (kinks: the ball
+    B(0, κ_a) at ξ_a = 0), and the force scale max(|c|, |Sz|, |∇Φ|, κ)."""
+    tan, kappa = kink.tangential, kink.radius
+    Sz = S @ z
+    gphi = energy.gradient(z)
+    g = Sz - c + gphi
+    xi = z[tan] if tan.size else np.zeros((0, 0))
+    s = np.linalg.norm(xi, axis=1)
+    at_zero = s == 0
+    unit = np.where(at_zero[:, None], 0.0, xi / np.where(at_zero, 1.0, s)[:, None])
+    h = (g[tan] if tan.size else np.zeros((0, 0))) - kappa[:, None] * unit
+    hn = np.linalg.norm(h, axis=1)
+    pg = g.copy()
+    wall = np.isfinite(upper) & (z >= upper) & (g < 0)
+    pg[wall] = 0.0
+    if tan.size:
+        slide = np.where(hn > kappa, 1.0 - kappa / np.where(hn > 0, hn, 1.0), 0.0)
+        pg[tan[at_zero]] = (h * slide[:, None])[at_zero]
+    scale = max(np.abs(c).max(initial=0.0), np.abs(Sz).max(initial=0.0),
+                np.abs(gphi).max(initial=0.0), kappa.max(initial=0.0), 1e-300)
+    return Stationarity(g=g, Sz=Sz, xi=xi, s=s, at_zero=at_zero, unit=unit, h=h, hn=hn, pg=pg,
+                        wall=wall, scale=scale, residual=np.abs(pg).max(initial=0.0))

@@ -1,0 +1,205 @@
+"""Step method "newton" (the default): the globalised projected
+semismooth Newton method for the step of (4.1) on the contact unknowns.
+
+With the interior condensed out (:mod:`adhesive_contact.scheme.condensed`), a step
+minimises the energy of MODEL.md §5 over the contact unknowns z,
+
+    E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z_ν ≤ g  (the wall),
+
+with Φ the contact terms (:class:`~adhesive_contact.contact_energy.ContactEnergy`).
+Friction laws with a kink at ξ = 0 (Tresca, slip weakening) add, at each
+contact node a, a term with Clarke subdifferential B(0, κ_a) at ξ_a = 0.
+
+The method is a projected semismooth Newton iteration with an Armijo line
+search on E, combining Bertsekas' two-metric projection for the wall with
+the orthant-wise treatment of the kink (as in OWL-QN):
+
+- the binding set: z_i within ε of the wall and ∂_i E < 0 — moved onto it
+  and held there;
+- the stick set: |ξ_a| ≤ ε and |h_a| ≤ κ_a, h_a the gradient without the
+  kink — ξ_a is set to 0 and held there;
+- every other node slips with its direction ê_a = ξ_a/|ξ_a| held for the
+  step (or, at ξ_a = 0, ê_a = −(pseudo-gradient), and the Newton step of
+  such a node is projected onto the ray along ê_a): a trial ξ_a that turns
+  against ê_a is put to 0, so the sign of ξ/|ξ| cannot flip inside a step;
+- on the free coordinates a Newton step with H = S + ∂²Φ (a modified
+  Cholesky when H is indefinite, e.g. under strong slip weakening),
+  coupled to the fixed coordinates' moves; should its line search fail
+  (a nonconvex energy far from the solution), the scaled projected
+  gradient instead;
+- z(α) projected as above, α halved until
+  E(z(α)) ≤ E(z) + σ E'(z; z(α) − z) (up to the round-off of E, so that
+  the full step is taken once the decrease is below what E can resolve).
+
+It stops when the pseudo-gradient (the minimal-norm element of
+∂E + normal cone of the wall, :func:`~.base.stationarity`) is below
+``tol`` times the force scale of the step, and returns the wall
+multipliers λ = −∂_ν E ≥ 0 on the wall.
+
+With ``globalised=False`` (method "newton-plain",
+:mod:`.newton_plain`) every step is the full projected Newton step: no
+line search and no gradient fallback, what many codes do; it stops as
+DIVERGED when the energy or the iterate stops being finite or the iterate
+grows past 1e8 times the size of the first one.
+"""
+
+import numpy as np
+
+from .base import (
+    CONVERGED,
+    DIVERGED,
+    LINE_SEARCH_FAILED,
+    MAX_ITERATIONS,
+    MESSAGES,
+    Kink,
+    StepResult,
+    no_kink,
+    stationarity,
+)
+
+__all__ = ["minimise", "minimise_step", "StepResult", "Kink", "CONVERGED",
+           "MAX_ITERATIONS", "LINE_SEARCH_FAILED", "DIVERGED"]
+
+
+def minimise(S, c, energy, upper, z0, options, kink=None):
+    """The step method interface (:mod:`adhesive_contact.step_methods`)."""
+    return minimise_step(S, c, energy, upper, z0, options.tol, options.max_iter, kink)
+
+
+def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, sigma=1e-4,
+                  globalised=True):
+    """Minimise ½ zᵀSz − cᵀz + Φ(z) subject to z ≤ upper (see module doc).
+
+    Parameters
+    ----------
+    S : the condensed step matrix, a
+        :class:`~adhesive_contact.scheme.condensed.DenseSchur` or
+        :class:`~adhesive_contact.scheme.condensed.ImplicitSchur`
+        (``S @ z``, ``diagonal()``, ``newton_solve``)
+    c : (nz,)
+    energy : ContactEnergy
+    upper : (nz,) bounds, +inf where there is none
+    z0 : (nz,) initial guess
+    tol : relative tolerance on the pseudo-gradient
+    kink : Kink or None
+    globalised : False for the full projected Newton step every iteration
+        (no line search, no gradient fallback)
+    """
+    nz = c.size
+    bounded = np.isfinite(upper)
+    if kink is None:
+        kink = no_kink()
+    tan, kappa = kink.tangential, kink.radius
+
+    def total(z):
+        return 0.5 * z @ (S @ z) - c @ z + energy.value(z)
+
+    def noise(z, Sz):
+        # round-off of E: below it an energy comparison says nothing
+        return 1e-13 * (0.5 * abs(z @ Sz) + abs(c @ z) + abs(energy.value(z)) + 1e-300)
+
+    z = np.minimum(z0, upper)
+    E = total(z)
+    diag_S = np.maximum(S.diagonal(), 1e-300) if nz else np.zeros(0)
+    inner_failures = 0
+    for it in range(max_iter + 1):
+        st = stationarity(S, c, energy, upper, z, kink)
+        g, xi, s, at_zero, unit = st.g, st.xi, st.s, st.at_zero, st.unit
+        hn, pg, wall, scale, residual = st.hn, st.pg, st.wall, st.scale, st.residual
+        status = (CONVERGED if residual <= tol * scale else
+                  MAX_ITERATIONS if it == max_iter else None)
+        if status is not None:
+            break
+
+        # identify the sets with a projected-gradient step length ε
+        width = np.abs(z - np.minimum(z - pg / np.where(diag_S > 0, diag_S, 1.0),
+                                      upper)).max(initial=0.0)
+        binding = bounded & (z >= upper - width) & (g < 0)
+        stuck = (s <= width) & (hn <= kappa)
+        fixed = binding.copy()
+        d = np.zeros(nz)
+        if tan.size:
+            fixed[tan[stuck]] = True
+            d[tan[stuck]] = -xi[stuck]
+        zmax = np.abs(z).max(initial=0.0)
+        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)   # sparse, nodal blocks
+        d[binding] = upper[binding] - z[binding]   # onto the wall
+        free = ~fixed
+        if free.any():
+            moved = np.where(fixed, d, 0.0)
+            rhs = -pg[free] - ((S @ moved)[free] + (Hphi @ moved)[free])
+            d[free], converged = S.newton_solve(Hphi, rhs, free)
+            inner_failures += not converged
+
+        # slipping directions held for this step
+        ref = unit.copy()
+        if tan.size:
+            start = at_zero & ~stuck
+            ref[start] = -pg[tan[start]] / np.maximum(
+                np.linalg.norm(pg[tan[start]], axis=1), 1e-300)[:, None]
+            # a node leaving ξ = 0 moves along its held direction only: the
+            # coupled Newton step may point it elsewhere (in 3D), and a slip
+            # off the direction of −h meets a friction force of size κ_a in
+            # the wrong direction; the next step turns it back to 0, and
+            # with a flat energy the two iterates alternate for ever
+            along = np.maximum(np.sum(d[tan[start]] * ref[start], axis=1), 0.0)
+            d[tan[start]] = along[:, None] * ref[start]
+
+        def project(trial):
+            trial = np.minimum(trial, upper)
+            if tan.size:
+                txi = trial[tan]
+                turned = np.sum(txi * ref, axis=1) <= 0   # stuck nodes reach 0 at α = 1
+                txi[turned] = 0.0
+                trial[tan] = txi
+            return trial
+
+        def slope(step):
+            # E'(z; step): the kink adds κ |Δξ| at nodes where ξ = 0
+            out = g @ step
+            if tan.size:
+                out += kappa[at_zero] @ np.linalg.norm(step[tan[at_zero]], axis=1)
+            return out
+
+        # the Newton direction, else (nonconvex energy, far from the
+        # solution) the scaled projected gradient, which always descends
+        slack = noise(z, st.Sz)
+        gradient_step = -pg / np.where(diag_S > 0, diag_S, 1.0)
+        if tan.size:
+            gradient_step[tan[stuck]] = -xi[stuck]
+        if not globalised:
+            trial = project(z + d)
+            E_trial = total(trial)
+            size = np.abs(trial).max(initial=0.0)
+            if it == 0:
+                first_size = max(size, np.abs(z).max(initial=0.0), 1e-300)
+            if not (np.isfinite(E_trial) and np.all(np.isfinite(trial))
+                    and size <= 1e8 * first_size):
+                status = DIVERGED
+                break
+            z, E = trial, E_trial
+            continue
+        found = False
+        for direction in (d, gradient_step):
+            alpha = 1.0
+            for _ in range(60):
+                trial = project(z + alpha * direction)
+                E_trial = total(trial)
+                if E_trial <= E + sigma * slope(trial - z) + slack:
+                    found = True
+                    break
+                alpha *= 0.5
+            if found:
+                break
+        if not found:
+            status = LINE_SEARCH_FAILED
+            break
+        z, E = trial, E_trial
+    # one exit: the wall multipliers and sets of the last iterate z
+    message = MESSAGES[status].format(max_iter=max_iter, nit=it)
+    if inner_failures:
+        message += f" ({inner_failures} Newton systems solved inexactly)"
+    return StepResult(z=z, status=status, message=message, nit=it,
+                      residual=residual / scale, tolerance=tol, energy=E,
+                      inner_failures=inner_failures, multiplier=np.where(wall, -g, 0.0),
+                      on_wall=wall, stuck=at_zero)
