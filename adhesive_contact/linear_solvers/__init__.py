@@ -93,10 +93,10 @@ def choose(n, nnz, dim, memory_limit=None):
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
     limit = default_memory_limit() if memory_limit is None else float(memory_limit)
-    if pardiso.available() and n < SMALL[dim]:
+    if n < SMALL[dim]:   # decided before asking for MKL, whose loading is the cost
         direct, label, why = "superlu", "SuperLU", (
             f"the matrix is small ({n} < {SMALL[dim]} dofs in {dim}D: SuperLU sets up faster "
-            "than PARDISO loads MKL)")
+            "than PARDISO, whose first use loads MKL)")
     elif pardiso.available():
         direct, label, why = "pardiso", "PARDISO", "MKL PARDISO is available"
     else:
