@@ -43,7 +43,9 @@ def boundary_mass(u, v, w):
 def trace_constant_squared(scene):
     """λ_max of ∫_{Γ_C} u·v = λ ∫_Ω ε(u):ε(v) on the scene's unrefined mesh
     (kept per mesh and sides: the variants of a sweep share it)."""
-    return _trace_constant(replace(scene.mesh, refine=0), tuple(scene.dirichlet),
+    # a side that holds some components only is taken as clamped: c_e is
+    # then a little smaller than with those components free
+    return _trace_constant(replace(scene.mesh, refine=0), tuple(scene.held_sides),
                            tuple(scene.contact_sides))
 
 
