@@ -43,10 +43,11 @@ class PrescribedDisplacement:
     dim : int
     """
 
-    def __init__(self, fixed, sides, dim, groups, shares):
+    def __init__(self, fixed, sides, dim, groups, shares, side_dofs=None):
         self.fixed = fixed
         self.sides = sides
         self.dim = dim
+        self._side_dofs = side_dofs or {}   # side -> {component: held dofs}
         # (positions within fixed, expression, coordinates (d, m)) of the nonzero data
         self._groups = groups
         self._shares = shares.tocsr()   # (nsides·d, nD): reaction share of each side
@@ -62,6 +63,10 @@ class PrescribedDisplacement:
         for positions, expr, x in self._groups:
             g[positions] = expr(*coordinates(x), t=t)
         return g
+
+    def side_dofs(self, side):
+        """{component: the dofs of ``side`` held in that component}."""
+        return self._side_dofs[side]
 
     def side_reactions(self, nodal):
         """Σ per side and component of the nodal reactions ``nodal`` (..., nD):
@@ -114,7 +119,10 @@ def prescribed_displacement(scene, mesh):
     if scene.exact is not None:
         _check_exact(rows, scene, mesh, times)
     check_rigid_motions(mesh, fixed, sides)
-    return PrescribedDisplacement(fixed, sides, d, groups, shares)
+    side_dofs = {side: {} for side in sides}
+    for s, c, dofs, expr, key in rows:
+        side_dofs[sides[s]][c] = dofs
+    return PrescribedDisplacement(fixed, sides, d, groups, shares, side_dofs)
 
 
 def _check_agreement(rows, fixed, count, mesh, times):
