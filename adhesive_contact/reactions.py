@@ -53,3 +53,35 @@ def prescribed_history(solution, side):
         positions = np.searchsorted(held.fixed, dofs)
         out[:, c] = [held.values(t)[positions].mean() for t in solution.t]
     return out
+
+
+def side_mean_displacement(solution, side):
+    """The mean nodal displacement of a side per level (M+1, d)."""
+    from .meshes import named_facets
+
+    mesh = solution.problem.mesh
+    nodes = np.unique(mesh.facets[:, named_facets(mesh, [side], "side", indexed=False)])
+    return np.array([solution.u[n][nodes].mean(axis=0) for n in range(solution.t.size)])
+
+
+def applied_traction(problem, side, times):
+    """The total force ∫_side f_N(x, t) ds of a loaded side's traction at
+    ``times`` (len(times), d), by a Gauss rule of order 4 on its facets."""
+    from skfem import ElementTetP1, ElementTriP1, FacetBasis
+
+    from .expressions import coordinates
+    from .meshes import named_facets
+
+    mesh, d = problem.mesh, problem.dim
+    facets = named_facets(mesh, [side], "loads.traction", indexed=False)
+    basis = FacetBasis(mesh, ElementTriP1() if d == 2 else ElementTetP1(), facets=facets,
+                       intorder=4)
+    x = np.asarray(basis.global_coordinates().value)            # (d, nfacets, nq)
+    weights = np.asarray(basis.dx)                              # (nfacets, nq)
+    exprs = problem.scene.traction[side]
+    out = np.zeros((len(times), d))
+    for i, t in enumerate(times):
+        for c, expr in enumerate(exprs):
+            out[i, c] = np.sum(np.broadcast_to(expr(*coordinates(x), t=t), weights.shape)
+                               * weights)
+    return out

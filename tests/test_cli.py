@@ -26,7 +26,7 @@ SCENE = to_toml(BLOCK)
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
-             "iterations", "residual"}
+             "iterations", "residual", "reactions", "contact_force"}
 SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "linear",
                 "iterations", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds",
@@ -83,7 +83,10 @@ def test_solve_writes_every_output(solved):
 def test_npz_has_the_firm_keys_and_shapes(solved):
     _, out, _ = solved
     with np.load(out / "solution.npz") as data:
-        assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta"}
+        assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta",
+                                   "reactions", "reaction_sides"}
+        assert list(data["reaction_sides"]) == ["top"]
+        assert data["reactions"].shape == (NLEVELS, 1, 2)
         assert data["points"].shape == (NPOINTS, 2)
         assert data["cells"].shape == (NCELLS, 3)
         assert data["contact_facets"].shape == (NFACETS, 2)
@@ -117,6 +120,8 @@ def test_summary_has_one_record_per_level(solved):
     assert len(steps) == NLEVELS
     for n, step in enumerate(steps):
         assert set(step) == STEP_KEYS
+        assert list(step["reactions"]) == ["top"] and len(step["reactions"]["top"]) == 2
+        assert len(step["contact_force"]) == 2
         assert step["t"] == pytest.approx(n / 3)
         assert np.shape(step["probes"]) == (2, 2)
         assert isinstance(step["tangential_force"], float)
@@ -544,8 +549,8 @@ def test_glued_contact_xdmf_has_beta_per_time_step(glued):
 def test_glued_plots_are_written(glued):
     result, out, _, _ = glued
     assert "Γ_C at t = 1: β mean" in result.stdout and "slip" in result.stdout
-    assert set(p.name for p in out.iterdir()) == FILES
-    for name in ("contact_traction.png", "beta.png"):
+    assert set(p.name for p in out.iterdir()) == FILES | {"load_displacement.png"}
+    for name in ("contact_traction.png", "beta.png", "load_displacement.png"):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
 
 

@@ -206,3 +206,22 @@ def test_relaxation_test_follows_the_modulus():
         errors.append(np.abs(modulus - closed).max())
         assert errors[-1] <= k * E1 / tau            # the rectangle rule's bound
     assert errors[1] / errors[0] == pytest.approx(0.5, abs=0.05)
+
+
+def test_reactions_contact_and_loads_balance():
+    # Σ_sides R + Σ_a F_a + ∫ f_N = 0 with memory, contact and a traction
+    from adhesive_contact.postprocess import total_contact_force
+    from adhesive_contact.reactions import applied_traction
+
+    data = scene_dict({"boundary.dirichlet": ["left"], "mesh.cells": [8, 2],
+                       "boundary.displacement": {"top": ["free", "-0.001*t*x"]},
+                       "memory": prony((200.0, 0.3, 0.5)), "time.steps": 3,
+                       "loads.traction.right": ["20*t", "40*t"],
+                       "contact.normal": {"law": "adhesive_compliance", "c": 1e4,
+                                          "gamma": 50.0, "L": 0.01}})
+    problem = build_problem(scene_from_dict(data))
+    sol = solve(problem)
+    assert sol.success and reaction_sides(problem) == ("left", "top")
+    total = (reactions(sol).sum(axis=1) + total_contact_force(sol)
+             + applied_traction(problem, "right", sol.t))
+    np.testing.assert_allclose(total, 0.0, atol=1e-9 * np.abs(reactions(sol)).max())
