@@ -12,7 +12,7 @@ from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 from conftest import DELETE, law, prony, scene_dict, to_toml
 
-from adhesive_contact import build_problem, parse_scene
+from adhesive_contact import build_problem, parse_scene, solve
 
 # an 8x4 block hanging from its top, pulled down onto a wall with a gap that
 # is smallest in the middle: the wall becomes active at step 1 (7 nodes)
@@ -581,3 +581,31 @@ def test_bad_law_exits_2_with_one_line_naming_the_key(tmp_path, changes, key):
     result = run("solve", scene, "--out", tmp_path / "out")
     assert_one_line_error(result, 2, key)
     assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written
+
+
+def test_glued_contact_xdmf_carries_the_contact_fields(glued):
+    from adhesive_contact.postprocess import contact_state_codes, contact_traction
+
+    _, out, _, arrays = glued
+    problem = build_problem(parse_scene(GLUED))
+    sol = solve(problem)
+    nodes = problem.boundary.nodes
+    reader = meshio.xdmf.TimeSeriesReader(out / "contact.xdmf")
+    reader.read_points_cells()
+    codes = contact_state_codes(sol)
+    traction = contact_traction(sol, "global")
+    for n in range(reader.num_steps):
+        _, point_data, _ = reader.read_data(n)
+        np.testing.assert_allclose(point_data["traction"][nodes, :2], traction[n],
+                                   rtol=1e-9, atol=1e-9 * np.abs(traction).max())
+        np.testing.assert_allclose(point_data["normal_traction"][nodes],
+                                   -contact_traction(sol)[n, :, 0], rtol=1e-9, atol=1e-6)
+        np.testing.assert_array_equal(point_data["state"][nodes], codes[n])
+        np.testing.assert_allclose(point_data["u_normal"][nodes],
+                                   sol.frame_displacement[n, :, 0], atol=1e-12)
+        np.testing.assert_allclose(point_data["slip"][nodes],
+                                   np.abs(sol.frame_displacement[n, :, 1]), atol=1e-12)
+    # all stuck at t = 0; then the right end separates while the rest sticks
+    # and finally slips
+    assert set(codes[0].tolist()) == {3} and set(codes[1].tolist()) == {0, 3, 4}
+    assert set(codes[-1].tolist()) == {0, 4}
