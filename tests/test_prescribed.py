@@ -225,3 +225,17 @@ def test_reactions_contact_and_loads_balance():
     total = (reactions(sol).sum(axis=1) + total_contact_force(sol)
              + applied_traction(problem, "right", sol.t))
     np.testing.assert_allclose(total, 0.0, atol=1e-9 * np.abs(reactions(sol)).max())
+
+
+def test_cli_refuses_a_body_free_to_move_with_exit_2(tmp_path):
+    from conftest import to_toml
+    from test_cli import run
+
+    path = tmp_path / "loose.toml"
+    path.write_text(to_toml(scene_dict({"boundary.dirichlet": [], "boundary.contact": [],
+                                        "boundary.displacement": {"left": ["0", "free"]}})))
+    result = run("solve", path, "--out", tmp_path / "out")
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: boundary: the held sides (left)")
+    assert "(translation along y)" in lines[0] and "Traceback" not in result.stderr
