@@ -239,3 +239,17 @@ def test_cli_refuses_a_body_free_to_move_with_exit_2(tmp_path):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: boundary: the held sides (left)")
     assert "(translation along y)" in lines[0] and "Traceback" not in result.stderr
+
+
+def test_large_displacements_and_far_stiffness_are_warned():
+    from adhesive_contact.sanity import magnitude_warnings
+
+    # the right end moved by 0.4 (0.402 with the contraction) on a body of size 2.06
+    data = scene_dict({"boundary.displacement.right": ["0.4*t", "free"]}, STRETCH)
+    sol = solve(build_problem(scene_from_dict(data)))
+    (line,) = magnitude_warnings(sol)
+    assert line.startswith("the largest displacement 0.402 is 20% of the body's size 2.06")
+    assert magnitude_warnings(solve(build_problem(scene_from_dict(STRETCH)))) == []
+    stiff = scene_dict({"contact.normal": {"law": "compliance", "c": 1e12}})
+    (line,) = magnitude_warnings(solve(build_problem(scene_from_dict(stiff))))
+    assert line.startswith("contact.normal.c = 1e+12 times the body's size is 2.1e+09 times")
