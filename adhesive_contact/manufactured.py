@@ -256,8 +256,8 @@ def memory_terms(scene):
     """R as a list of (kernel(lag), λ, μ): Prony terms or r(t) C_0."""
     if scene.memory is None:
         return []
-    if scene.memory.kernel == "prony":
+    if scene.memory.kernel in ("prony", "relaxation"):
         return [(lambda lag, tau=term.tau: np.exp(-lag / tau), term.tensor.lam, term.tensor.mu)
-                for term in scene.memory.terms]
+                for term in scene.memory.prony_terms]
     r = scene.memory.function
     return [(lambda lag: r(lag, t=lag), scene.memory.tensor.lam, scene.memory.tensor.mu)]

@@ -10,6 +10,8 @@ tr ε(a_λ) I + 2 ε(a_μ) (see :mod:`adhesive_contact.assembly`).
 - Prony series R(t) = Σ_m e^{−t/τ_m} C_m (MODEL.md §6): with
   h_n^m = k Σ_{j<n} e^{−(t_n−t_j)/τ_m} u_j one has h_1^m = 0 and
   h_n^m = e^{−k/τ_m} (h_{n−1}^m + k u_{n−1}) exactly: O(1) per step.
+- A relaxation modulus G(t) = C_∞ + Σ_i e^{−t/τ_i} C_i is the Prony series
+  R = G' with C_m = −C_i/τ_i (the instantaneous G(0) is the elastic tensor).
 - A scalar kernel R(t) = r(t) C_0: the history k Σ_{j<n} r(t_n − t_j) u_j
   is summed directly, O(n) per step.
 
@@ -105,8 +107,8 @@ def make_memory(spec):
     """The memory object of a scene's MemorySpec (None: no memory)."""
     if spec is None:
         return NoMemory()
-    if spec.kernel == "prony":
-        return PronyMemory([t.tensor.lam for t in spec.terms],
-                           [t.tensor.mu for t in spec.terms],
-                           [t.tau for t in spec.terms])
+    if spec.kernel in ("prony", "relaxation"):   # relaxation: C_m = −C_i/τ_i
+        terms = spec.prony_terms
+        return PronyMemory([t.tensor.lam for t in terms], [t.tensor.mu for t in terms],
+                           [t.tau for t in terms])
     return FunctionMemory(spec.function, spec.tensor.lam, spec.tensor.mu)

@@ -186,3 +186,59 @@ def contact_states(solution):
         out["stick"] = touching & solution.stuck
         out["slip"] = touching & ~solution.stuck & moving
     return out
+
+
+#: the integer codes of :func:`contact_state_code`
+SEPARATED, COMPLIANCE, WALL, STICK, SLIP = 0, 1, 2, 3, 4
+STATE_NAMES = ("separated", "compliance", "wall", "stick", "slip")
+
+
+def contact_state_code(problem, frame_displacement, on_wall, stuck):
+    """One integer state per contact node, of one level or of several.
+
+    0 separated (u_ν < 0); for a touching node (u_ν ≥ 0), with a friction
+    law, 3 stick (held at ξ = 0 by a friction kink) or 4 slip (u_τ ≠ 0,
+    not stuck); otherwise 2 wall (u_ν = g) or 1 compliance. A node that
+    sticks or slips may also be on the wall (``on_wall`` says so).
+
+    Parameters
+    ----------
+    problem : Problem
+    frame_displacement : (..., nc, d) nodal-frame displacements
+    on_wall, stuck : (..., nc) bool
+
+    Returns
+    -------
+    ndarray of int8, (..., nc)
+    """
+    frame_displacement = np.asarray(frame_displacement)
+    touching = frame_displacement[..., 0] >= 0
+    code = np.where(np.asarray(on_wall), WALL, COMPLIANCE)
+    if problem.friction is not None:
+        moving = np.linalg.norm(frame_displacement[..., 1:], axis=-1) > 0
+        code = np.where(moving, SLIP, code)
+        code = np.where(np.asarray(stuck), STICK, code)
+    return np.where(touching, code, SEPARATED).astype(np.int8)
+
+
+def contact_state_codes(solution):
+    """:func:`contact_state_code` at every level (N+1, nc)."""
+    return contact_state_code(solution.problem, solution.frame_displacement,
+                              solution.on_wall, solution.stuck)
+
+
+def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):
+    """The per-node contact quantities of one level, for ParaView:
+    ``traction`` (nc, d) global components, ``normal_traction`` (nc,)
+    positive in compression, ``tangential_traction`` (nc, d−1) in the nodal
+    tangent frames, ``u_normal`` (nc,), ``slip`` |u_τ| (nc,), ``state`` (nc,)
+    (:func:`contact_state_code`)."""
+    weights = problem.boundary.node_weights[:, None]
+    nodal = np.asarray(contact_force) / weights
+    frame_displacement = np.asarray(frame_displacement)
+    return {"traction": to_global(problem, nodal),
+            "normal_traction": -nodal[:, 0],
+            "tangential_traction": nodal[:, 1:],
+            "u_normal": frame_displacement[:, 0],
+            "slip": np.linalg.norm(frame_displacement[:, 1:], axis=-1),
+            "state": contact_state_code(problem, frame_displacement, on_wall, stuck)}

@@ -23,6 +23,7 @@ from .contact_boundary import (
     facet_points,
     tangent_frame,
 )
+from .dirichlet import prescribed_displacement
 from .expressions import coordinates
 from .foundation import foundation_gap
 from .laws import make_bonding, make_friction, make_normal_law
@@ -45,7 +46,8 @@ class Problem:
     scene: object
     mesh: object
     assembly: Assembly
-    free: np.ndarray          # free dofs (not on Γ_D)
+    free: np.ndarray          # free dofs (not held by a side)
+    prescribed: object        # PrescribedDisplacement: the held dofs and g_D(t)
     boundary: object          # ContactBoundary, or None
     columns: np.ndarray       # the step's unknowns among the nc·d frame components
     contact_positions: np.ndarray  # positions of those unknowns within ``free``
@@ -130,9 +132,10 @@ def build_problem(scene):
 
     dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
     contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
-    clamped_nodes = np.unique(mesh.facets[:, dirichlet_facets])
-    free = np.setdiff1d(np.arange(assembly.ndofs),
-                        assembly.nodal_dofs[:, clamped_nodes].ravel())
+    prescribed = prescribed_displacement(scene, mesh)
+    # a node with any held component leaves Γ_C (module adhesive_contact.dirichlet)
+    clamped_nodes = np.unique(prescribed.fixed // d)
+    free = np.setdiff1d(np.arange(assembly.ndofs), prescribed.fixed)
     position = np.full(assembly.ndofs, -1)
     position[free] = np.arange(free.size)
 
@@ -202,7 +205,8 @@ def build_problem(scene):
             beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
             beta0 = _facet_mean(mesh, boundary, exact.beta)
     loads = LoadMap(mesh, body, surface)
-    return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free, boundary=boundary,
+    return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free,
+                   prescribed=prescribed, boundary=boundary,
                    columns=columns, contact_positions=contact_positions, loads=loads, gap=gap,
                    beta0=beta0, normal_law=normal_law, friction=friction, bonding=bonding,
                    probe_map=probe_map, times=times,

@@ -91,12 +91,33 @@ class PronyTerm:
 
 @dataclass(frozen=True)
 class MemorySpec:
-    """Relaxation kernel R: ``prony`` (terms) or ``function`` (r(t) C_0)."""
+    """The memory kernel R of σ = C ε + ∫_0^t R(t − s) ε(s) ds.
+
+    - ``prony``: R(t) = Σ_m e^{−t/τ_m} C_m (``terms``), added to [material]'s C;
+    - ``function``: R(t) = r(t) C_0;
+    - ``relaxation``: a relaxation modulus G(t) = C_∞ + Σ_i e^{−t/τ_i} C_i
+      (``long_term`` C_∞, ``terms`` the C_i with τ_i), σ(t) = ∫_0^t G(t − s) dε(s)
+      = G(0) ε(t) + ∫_0^t G'(t − s) ε(s) ds: C = G(0) = C_∞ + Σ_i C_i (the
+      scene's ``material``) and R(t) = G'(t) = −Σ_i (1/τ_i) e^{−t/τ_i} C_i
+      (:attr:`prony_terms`).
+    """
 
     kernel: str
     terms: tuple = ()
     function: object = None       # Expression r(t) for kernel = "function"
     tensor: Isotropic = None      # C_0 for kernel = "function"
+    long_term: Isotropic = None   # C_∞ for kernel = "relaxation"
+
+    @property
+    def prony_terms(self):
+        """R as Prony terms (tensor, τ): the terms themselves for ``prony``,
+        (−C_i/τ_i, τ_i) for ``relaxation``; () for ``function``."""
+        if self.kernel == "prony":
+            return self.terms
+        if self.kernel == "relaxation":
+            return tuple(PronyTerm(Isotropic(-t.tensor.lam / t.tau, -t.tensor.mu / t.tau), t.tau)
+                         for t in self.terms)
+        return ()
 
 
 @dataclass(frozen=True)
@@ -203,6 +224,14 @@ class Scene:
     solver: SolverSpec
     probes: tuple
     exact: ExactSpec = None       # None: no manufactured solution
+    displacement: dict = field(default_factory=dict)  # side -> d Expressions or None ("free")
+
+    @property
+    def held_sides(self):
+        """The sides with a prescribed displacement: Dirichlet (u = 0) sides,
+        then the sides of [boundary.displacement], each once."""
+        return tuple(self.dirichlet) + tuple(s for s in self.displacement
+                                             if s not in self.dirichlet)
 
     @property
     def k(self):
@@ -224,7 +253,11 @@ class Scene:
         return {
             "title": self.title, "dim": self.dim,
             "mesh": _mesh_record(self.mesh),
-            "boundary": {"dirichlet": list(self.dirichlet), "contact": list(self.contact_sides)},
+            "boundary": {"dirichlet": list(self.dirichlet), "contact": list(self.contact_sides),
+                         **({"displacement": {
+                             side: [e.source if e is not None else "free" for e in exprs]
+                             for side, exprs in self.displacement.items()}}
+                            if self.displacement else {})},
             "material": {**_young(self.material), "lam": self.material.lam,
                          "mu": self.material.mu},
             "memory": _memory_record(self.memory),
@@ -273,6 +306,9 @@ def _memory_record(memory):
         return None
     if memory.kernel == "prony":
         return {"kernel": "prony",
+                "terms": [{**_pair(t.tensor), "tau": t.tau} for t in memory.terms]}
+    if memory.kernel == "relaxation":
+        return {"kernel": "relaxation", "long_term": _pair(memory.long_term),
                 "terms": [{**_pair(t.tensor), "tau": t.tau} for t in memory.terms]}
     return {"kernel": "function", "r": memory.function.source, **_pair(memory.tensor)}
 
@@ -524,17 +560,56 @@ def _read_sides(table, name, dim, named_by_file):
 
 
 def _read_boundary(table, dim, named_by_file=False):
-    """(Dirichlet sides, contact sides): disjoint, at least one Dirichlet side."""
+    """(Dirichlet sides, contact sides, {side: prescribed displacement}):
+    the Dirichlet, displacement and contact sides are disjoint; at least
+    one side holds the body (whether it holds it against every rigid motion
+    is checked with the geometry, when the problem is built)."""
     dirichlet = _read_sides(table, "dirichlet", dim, named_by_file)
     contact_sides = _read_sides(table, "contact", dim, named_by_file)
+    displacement = _read_displacement(table.table("displacement"), dim, named_by_file)
     table.finish()
-    if not dirichlet:
-        raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0)")
+    if not dirichlet and not displacement:
+        raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0), "
+                         "or [boundary.displacement] must prescribe a side")
     both = set(dirichlet) & set(contact_sides)
     if both:
         raise SceneError("boundary.contact", f"side {sorted(both)[0]!r} is also Dirichlet; "
                          "the parts of the boundary must be disjoint")
-    return dirichlet, contact_sides
+    for side in displacement:
+        if side in dirichlet or side in contact_sides:
+            raise SceneError(f"boundary.displacement.{side}", "is also a "
+                             f"{'Dirichlet' if side in dirichlet else 'contact'} side; the "
+                             "parts of the boundary must be disjoint")
+    return dirichlet, contact_sides, displacement
+
+
+def _read_displacement(table, dim, named_by_file):
+    """{side: d entries}: per component an Expression in x, y, (z), t, or
+    None for "free"; a side must prescribe at least one component."""
+    if table is None:
+        return {}
+    variables = _coordinates(dim) + ("t",)
+    out = {}
+    for side, raw in table.data.items():
+        key = table.key(side)
+        table.used.add(side)
+        if not named_by_file and side not in SIDES[dim]:
+            raise SceneError(key, f"unknown side; sides are {', '.join(SIDES[dim])}")
+        if not isinstance(raw, list) or len(raw) != dim:
+            raise SceneError(key, f"must be a list of {dim} entries (a number, an expression "
+                             f"or \"free\" per component), got {_show(raw)}")
+        for i, v in enumerate(raw):
+            if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+                raise SceneError(f"{key}[{i}]", "must be a number, an expression or "
+                                 f"\"free\", got {_show(v)}")
+        entries = tuple(None if v == "free" else _expression(f"{key}[{i}]", v, variables)
+                        for i, v in enumerate(raw))
+        if all(e is None for e in entries):
+            raise SceneError(key, "prescribes no component; give an expression for at "
+                             "least one, or remove the side")
+        out[side] = entries
+    table.finish()
+    return out
 
 
 def _read_material(table, dim):
@@ -547,24 +622,59 @@ def _read_memory(table, dim):
     """A MemorySpec, or None without a [memory] table."""
     if table is None:
         return None
-    kernel = _choice(table.key("kernel"), table.get("kernel", "str"), ("prony", "function"))
-    if kernel == "prony":
-        terms_raw = table.get("terms", "list")
-        if not terms_raw:
-            raise SceneError(table.key("terms"), "must list at least one term {E, nu, tau}")
-        terms = []
-        for i, raw in enumerate(terms_raw):
-            t = _Table(raw, f"{table.key('terms')}[{i}]")
-            tensor = _isotropic(t, dim)
-            tau = _positive(t.key("tau"), t.get("tau", "number"))
-            t.finish()
-            terms.append(PronyTerm(tensor, tau))
+    kernel = _choice(table.key("kernel"), table.get("kernel", "str"),
+                     ("prony", "function", "relaxation"))
+    if kernel == "function":
+        function = _expression(table.key("r"), table.get("r", "expr"), ("t",))
+        tensor = _isotropic(table, dim)
         table.finish()
-        return MemorySpec("prony", terms=tuple(terms))
-    function = _expression(table.key("r"), table.get("r", "expr"), ("t",))
-    tensor = _isotropic(table, dim)
+        return MemorySpec("function", function=function, tensor=tensor)
+    long_term = None
+    if kernel == "relaxation":
+        raw = table.get("long_term", "table")
+        lt = _Table(raw, table.key("long_term"))
+        long_term = _isotropic(lt, dim)
+        lt.finish()
+    terms_raw = table.get("terms", "list")
+    if not terms_raw:
+        raise SceneError(table.key("terms"), "must list at least one term {E, nu, tau}")
+    terms = []
+    for i, raw in enumerate(terms_raw):
+        t = _Table(raw, f"{table.key('terms')}[{i}]")
+        if kernel == "relaxation" and long_term.E is not None and t.has("E") \
+                and not t.has("nu") and not (t.has("lam") or t.has("mu")):
+            t.data = {**t.data, "nu": long_term.nu}   # nu defaults to long_term's
+        tensor = _isotropic(t, dim)
+        tau = _positive(t.key("tau"), t.get("tau", "number"))
+        t.finish()
+        terms.append(PronyTerm(tensor, tau))
     table.finish()
-    return MemorySpec("function", function=function, tensor=tensor)
+    return MemorySpec(kernel, terms=tuple(terms), long_term=long_term)
+
+
+def _instantaneous(memory):
+    """G(0) = C_∞ + Σ_i C_i of a relaxation kernel, as one Isotropic (its
+    (E, ν) when every part has the same ν: E adds up then)."""
+    parts = (memory.long_term,) + tuple(t.tensor for t in memory.terms)
+    lam, mu = sum(p.lam for p in parts), sum(p.mu for p in parts)
+    nus = {p.nu for p in parts}
+    if None not in nus and len(nus) == 1:
+        return Isotropic(lam, mu, sum(p.E for p in parts), nus.pop())
+    return Isotropic(lam, mu)
+
+
+def _check_relaxation_step(memory, dim, k):
+    """The step tensor G(0) + k R(0) = C_∞ + Σ_i (1 − k/τ_i) C_i must be
+    positive definite (else the step matrix is indefinite)."""
+    parts = [(memory.long_term, 1.0)] + [(t.tensor, 1.0 - k / t.tau) for t in memory.terms]
+    lam = sum(p.lam * w for p, w in parts)
+    mu = sum(p.mu * w for p, w in parts)
+    if not (mu > 0 and lam + 2.0 * mu / dim > 0):
+        tau = min(t.tau for t in memory.terms)
+        raise SceneError("time.steps", f"the time step k = {k:g} is too large for the "
+                         f"relaxation time tau = {tau:g}: the step tensor C_inf + "
+                         "sum (1 - k/tau_i) C_i is not positive definite; use more steps "
+                         f"(k well below {tau:g})")
 
 
 def _read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
@@ -586,7 +696,8 @@ def _read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
             if not named_by_file and side not in SIDES[dim]:
                 raise SceneError(key, f"unknown side; sides are {', '.join(SIDES[dim])}")
             if side in dirichlet or side in contact_sides:
-                raise SceneError(key, "a traction acts on a Neumann side only; "
+                raise SceneError(key, "a traction acts on a Neumann side only (or on the "
+                                 "free components of a displacement side); "
                                  f"{side!r} is a {'Dirichlet' if side in dirichlet else 'contact'} side")
             traction[side] = _vector_of_expressions(key, raw, dim, variables)
         tt.finish()
@@ -788,10 +899,17 @@ def scene_from_dict(data, base_dir=None):
         raise SceneError("dim", f"must be 2 (plane strain) or 3, got {dim}")
     mesh = _read_mesh(top.table("mesh", required=True), dim, base_dir)
     by_file = mesh.domain == "file"
-    dirichlet, contact_sides = _read_boundary(top.table("boundary", required=True), dim,
-                                              by_file)
-    material = _read_material(top.table("material", required=True), dim)
+    dirichlet, contact_sides, displacement = _read_boundary(
+        top.table("boundary", required=True), dim, by_file)
     memory = _read_memory(top.table("memory"), dim)
+    if memory is not None and memory.kernel == "relaxation":
+        if top.has("material"):
+            raise SceneError("material", "a relaxation kernel ([memory] kernel = "
+                             "\"relaxation\") gives the material; remove [material]")
+        top.used.add("material")
+        material = _instantaneous(memory)
+    else:
+        material = _read_material(top.table("material", required=True), dim)
     body, traction = _read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)
     contact = _read_contact(top.table("contact"), dim, contact_sides)
     T, steps = _read_time(top.table("time", required=True))
@@ -799,8 +917,10 @@ def scene_from_dict(data, base_dir=None):
     probes = _read_probes(top.table("output"), dim)
     exact = _read_exact(top.table("exact"), dim, contact, top.has("loads"))
     top.finish()
+    if memory is not None and memory.kernel == "relaxation":
+        _check_relaxation_step(memory, dim, T / steps)
     return Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
-                 traction, contact, T, steps, solver, probes, exact)
+                 traction, contact, T, steps, solver, probes, exact, displacement)
 
 
 def parse_scene(text, base_dir=None):

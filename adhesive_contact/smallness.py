@@ -87,7 +87,9 @@ def trace_constant_squared(scene, refine=None):
     :func:`trace_mesh_spec`); kept per mesh and sides (the variants of a
     sweep share it)."""
     refine = trace_mesh_refine(scene) if refine is None else refine
-    return _trace_constant(trace_mesh_spec(scene, refine), tuple(scene.dirichlet),
+    # a side that holds some components only is taken as clamped: c_e is
+    # then a little smaller than with those components free
+    return _trace_constant(trace_mesh_spec(scene, refine), tuple(scene.held_sides),
                            tuple(scene.contact_sides))
 
 

@@ -24,6 +24,7 @@ import click
 from adhesive_contact import solve
 from adhesive_contact.io import StreamingRecorder
 from adhesive_contact.postprocess import beta_mean
+from adhesive_contact.sanity import magnitude_warnings
 from adhesive_contact.scheme import STOPPED
 
 from .common import CliError, echo_warnings, load_scene, read_scene, scene_folder
@@ -128,6 +129,8 @@ def solve_command(scene, out):
                     solution = solve(problem, recorder=recorder,
                                      progress=lambda n, N: bar.update(1) or interrupted())
                 if solution.t.size:   # the levels that converged, partial or not
+                    for warning in magnitude_warnings(solution):
+                        click.echo(f"warning: {warning}", err=True)
                     files = write_results(solution, folder)
             finally:
                 recorder.close()

@@ -24,6 +24,7 @@ import tempfile
 from pathlib import Path
 
 from adhesive_contact.io import write_npz, write_xdmf
+from adhesive_contact.sanity import magnitude_warnings
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 
@@ -46,7 +47,7 @@ def summary(solution):
         },
         "run": run_record(solution),
         "smallness": smallness_record(problem),
-        "warnings": [str(w) for w in problem.warnings()],
+        "warnings": [str(w) for w in problem.warnings()] + magnitude_warnings(solution),
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
         "iterations": [int(i) for i in solution.iterations],

@@ -2,7 +2,10 @@
 
 :func:`write_plots` draws ``deformed.png`` always and, when the scene has a
 contact boundary, ``contact_traction.png`` and ``beta.png`` (and in 3D
-``contact_map.png``: β, the normal traction and the slip over Γ_C). The scene
+``contact_map.png``: β, the normal traction and the slip over Γ_C); and
+``load_displacement.png`` when a side is moved or loaded (the reaction of a
+side against its prescribed displacement, the applied force of a loaded
+side against its mean displacement). The scene
 carries no units, so axes are labelled in the scene's units (lengths as in
 ``mesh.size``, stresses as in ``material.E``). Matplotlib runs on the Agg
 backend (no display needed).
@@ -22,6 +25,13 @@ from adhesive_contact.postprocess import (  # noqa: E402
     cell_von_mises,
     normal_traction,
     tangential_traction,
+)
+from adhesive_contact.reactions import (  # noqa: E402
+    applied_traction,
+    prescribed_history,
+    reaction_sides,
+    reactions,
+    side_mean_displacement,
 )
 
 AXES = "xyz"
@@ -461,8 +471,50 @@ def plot_contact_map(solution, path):
     plt.close(fig)
 
 
+def load_curves(solution):
+    """The curves of ``load_displacement.png``: (label, displacement, force)
+    per moved component of a displacement side (its reaction against the
+    mean prescribed value) and per loaded side (the applied force along its
+    largest component against the side's mean displacement in it)."""
+    problem = solution.problem
+    curves = []
+    held = reactions(solution)
+    for i, side in enumerate(reaction_sides(problem)):
+        if side not in problem.scene.displacement:
+            continue
+        moved = prescribed_history(solution, side)
+        for c in range(problem.dim):
+            if np.isfinite(moved[:, c]).all() and np.abs(moved[:, c]).max() > 0:
+                curves.append((f"{side}: reaction R_{AXES[c]} against u_{AXES[c]} "
+                               "(prescribed)", moved[:, c], held[:, i, c]))
+    for side in problem.scene.traction:
+        force = applied_traction(problem, side, solution.t)
+        c = int(np.argmax(np.abs(force).max(axis=0)))
+        if np.abs(force[:, c]).max() > 0:
+            u = side_mean_displacement(solution, side)
+            curves.append((f"{side}: applied force F_{AXES[c]} against mean u_{AXES[c]}",
+                           u[:, c], force[:, c]))
+    return curves
+
+
+def plot_load_displacement(solution, path, curves=None):
+    """Force against displacement of the moved or loaded sides, one curve each."""
+    curves = load_curves(solution) if curves is None else curves
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for label, u, force in curves:
+        ax.plot(u, force, marker=".", markersize=3, label=label)
+    ax.axhline(0.0, color="0.7", linewidth=0.8)
+    ax.set_xlabel("displacement")
+    ax.set_ylabel("force on the body (per unit thickness in 2D)")
+    ax.legend(fontsize="small")
+    ax.set_title(f"{_title(solution)}\nload against displacement, t = 0..{solution.t[-1]:g}",
+                 fontsize="medium")
+    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    plt.close(fig)
+
+
 #: the figures :func:`write_plots` may draw, without the ``.png``
-PLOT_NAMES = ("deformed", "contact_traction", "beta", "contact_map")
+PLOT_NAMES = ("deformed", "contact_traction", "beta", "contact_map", "load_displacement")
 
 
 def write_plots(solution, folder):
@@ -483,4 +535,8 @@ def write_plots(solution, folder):
         if solution.problem.dim == 3:
             names.append("contact_map.png")
             plot_contact_map(solution, folder / names[-1])
+    curves = load_curves(solution)
+    if curves:
+        names.append("load_displacement.png")
+        plot_load_displacement(solution, folder / names[-1], curves)
     return names

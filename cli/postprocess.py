@@ -5,7 +5,8 @@ this module only formats them.
 
 import numpy as np
 
-from adhesive_contact.postprocess import beta_mean
+from adhesive_contact.postprocess import beta_mean, total_contact_force
+from adhesive_contact.reactions import reaction_sides, reactions
 from adhesive_contact.storage import json_number
 
 
@@ -41,7 +42,11 @@ def step_records(solution):
     without contact facets; separated, on_wall, stick and slip count contact
     nodes (:meth:`~adhesive_contact.Solution.contact_states`; stick and slip
     are None without friction; n_wall = on_wall, kept for older readers);
-    max_penetration is max_a (u_ν − g), None without a wall.
+    max_penetration is max_a (u_ν − g), None without a wall; ``reactions``
+    is {side: [F_x, F_y(, F_z)]}, the force each held side's support exerts
+    on the body (:mod:`adhesive_contact.reactions`), and ``contact_force``
+    the total force of Γ_C on the body in global components (None without
+    contact nodes).
     """
     d = solution.u.shape[2]
     normal = solution.total_normal_force()
@@ -49,6 +54,11 @@ def step_records(solution):
     means = beta_mean(solution)
     violation = solution.gap_violation()
     states = solution.contact_states()
+    sides = reaction_sides(solution.problem)
+    held = reactions(solution)
+    boundary = solution.problem.boundary
+    contact = (total_contact_force(solution) if boundary is not None and boundary.nodes.size
+               else None)
     records = []
     for n, t in enumerate(solution.t):
         has_beta = solution.beta.shape[1] > 0
@@ -68,5 +78,7 @@ def step_records(solution):
             "max_penetration": json_number(violation[n]),
             "iterations": int(solution.iterations[n]),
             "residual": json_number(solution.residual[n]),
+            "reactions": {side: _vector(held[n, i]) for i, side in enumerate(sides)},
+            "contact_force": None if contact is None else _vector(contact[n]),
         })
     return records

@@ -12,7 +12,7 @@ from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 from conftest import DELETE, law, prony, scene_dict, to_toml
 
-from adhesive_contact import build_problem, parse_scene
+from adhesive_contact import build_problem, parse_scene, solve
 
 # an 8x4 block hanging from its top, pulled down onto a wall with a gap that
 # is smallest in the middle: the wall becomes active at step 1 (7 nodes)
@@ -26,7 +26,7 @@ SCENE = to_toml(BLOCK)
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
-             "iterations", "residual"}
+             "iterations", "residual", "reactions", "contact_force"}
 SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "linear",
                 "iterations", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
@@ -85,7 +85,10 @@ def test_solve_writes_every_output(solved):
 def test_npz_has_the_firm_keys_and_shapes(solved):
     _, out, _ = solved
     with np.load(out / "solution.npz") as data:
-        assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta"}
+        assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta",
+                                   "reactions", "reaction_sides"}
+        assert list(data["reaction_sides"]) == ["top"]
+        assert data["reactions"].shape == (NLEVELS, 1, 2)
         assert data["points"].shape == (NPOINTS, 2)
         assert data["cells"].shape == (NCELLS, 3)
         assert data["contact_facets"].shape == (NFACETS, 2)
@@ -119,6 +122,8 @@ def test_summary_has_one_record_per_level(solved):
     assert len(steps) == NLEVELS
     for n, step in enumerate(steps):
         assert set(step) == STEP_KEYS
+        assert list(step["reactions"]) == ["top"] and len(step["reactions"]["top"]) == 2
+        assert len(step["contact_force"]) == 2
         assert step["t"] == pytest.approx(n / 3)
         assert np.shape(step["probes"]) == (2, 2)
         assert isinstance(step["tangential_force"], float)
@@ -550,8 +555,8 @@ def test_glued_contact_xdmf_has_beta_per_time_step(glued):
 def test_glued_plots_are_written(glued):
     result, out, _, _ = glued
     assert "Γ_C at t = 1: β mean" in result.stdout and "slip" in result.stdout
-    assert set(p.name for p in out.iterdir()) == FILES
-    for name in ("contact_traction.png", "beta.png"):
+    assert set(p.name for p in out.iterdir()) == FILES | {"load_displacement.png"}
+    for name in ("contact_traction.png", "beta.png", "load_displacement.png"):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
 
 
@@ -582,3 +587,31 @@ def test_bad_law_exits_2_with_one_line_naming_the_key(tmp_path, changes, key):
     result = run("solve", scene, "--out", tmp_path / "out")
     assert_one_line_error(result, 2, key)
     assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]   # nothing written
+
+
+def test_glued_contact_xdmf_carries_the_contact_fields(glued):
+    from adhesive_contact.postprocess import contact_state_codes, contact_traction
+
+    _, out, _, arrays = glued
+    problem = build_problem(parse_scene(GLUED))
+    sol = solve(problem)
+    nodes = problem.boundary.nodes
+    reader = meshio.xdmf.TimeSeriesReader(out / "contact.xdmf")
+    reader.read_points_cells()
+    codes = contact_state_codes(sol)
+    traction = contact_traction(sol, "global")
+    for n in range(reader.num_steps):
+        _, point_data, _ = reader.read_data(n)
+        np.testing.assert_allclose(point_data["traction"][nodes, :2], traction[n],
+                                   rtol=1e-9, atol=1e-9 * np.abs(traction).max())
+        np.testing.assert_allclose(point_data["normal_traction"][nodes],
+                                   -contact_traction(sol)[n, :, 0], rtol=1e-9, atol=1e-6)
+        np.testing.assert_array_equal(point_data["state"][nodes], codes[n])
+        np.testing.assert_allclose(point_data["u_normal"][nodes],
+                                   sol.frame_displacement[n, :, 0], atol=1e-12)
+        np.testing.assert_allclose(point_data["slip"][nodes],
+                                   np.abs(sol.frame_displacement[n, :, 1]), atol=1e-12)
+    # all stuck at t = 0; then the right end separates while the rest sticks
+    # and finally slips
+    assert set(codes[0].tolist()) == {3} and set(codes[1].tolist()) == {0, 3, 4}
+    assert set(codes[-1].tolist()) == {0, 4}

@@ -1,5 +1,6 @@
 """``solution.npz`` (keys ``points``, ``cells``, ``contact_facets``, ``t``,
-``u``, ``beta``), written entry by entry into a compressed zip, as
+``u``, ``beta``, ``reactions`` (N+1, n_sides, d): the force of each held
+side's support on the body, ``reaction_sides``: their names), written entry by entry into a compressed zip, as
 :func:`numpy.savez_compressed` would write it, but with the history u
 (N+1, npoints, d) streamed level by level from wherever it is kept."""
 
@@ -7,6 +8,7 @@ import zipfile
 
 import numpy as np
 
+from ..reactions import reaction_sides, reactions
 from .xdmf import contact_facets
 
 
@@ -38,3 +40,5 @@ def write_npz(solution, path):
         _write_array(archive, "t", solution.t)
         _write_levels(archive, "u", solution.u, solution.t.size)
         _write_array(archive, "beta", solution.beta)
+        _write_array(archive, "reactions", reactions(solution))
+        _write_array(archive, "reaction_sides", np.array(reaction_sides(problem), dtype=str))

@@ -4,7 +4,8 @@
 (:class:`~adhesive_contact.io.xdmf.XdmfSeries`) and u_n to a scratch HDF5
 file as soon as it is computed. In memory it keeps per level only what is
 small: β per contact facet, the contact force, frame displacement and
-states per contact node, the probes, the iterations and residual; and the
+states per contact node, the probes, the reactions per held dof, the
+iterations and residual; and the
 last level's u and σ. The Solution it builds reads u_n from the scratch
 file (:class:`DiskLevels`) and holds σ of the last level only.
 
@@ -22,7 +23,7 @@ from .xdmf import XdmfSeries
 
 #: kept per level in memory (small), as in HistoryRecorder
 SMALL = ("beta", "contact_force", "frame_displacement", "on_wall", "stuck", "probes",
-         "iterations", "residual")
+         "reaction", "iterations", "residual")
 SCRATCH = ".levels.h5"
 
 
@@ -106,5 +107,6 @@ def _empty_shapes(problem):
     nprobes = 0 if problem.probe_map is None else problem.probe_map.shape[0]
     return {"beta": ((nf,), float), "contact_force": ((nc, d), float),
             "frame_displacement": ((nc, d), float), "on_wall": ((nc,), bool),
-            "stuck": ((nc,), bool), "probes": ((nprobes, d), float), "iterations": ((), int),
+            "stuck": ((nc,), bool), "probes": ((nprobes, d), float),
+            "reaction": ((problem.prescribed.fixed.size,), float), "iterations": ((), int),
             "residual": ((), float)}

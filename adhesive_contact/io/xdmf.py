@@ -1,15 +1,20 @@
 """ParaView time series of a run: ``solution.xdmf`` (+ ``.h5``) with point
 data u (3 components) and cell data stress (3 × 3 flattened, the plane
 strain σ_zz included) and von_mises; ``contact.xdmf`` (+ ``.h5``) on the
-contact facets with cell data beta and point data u (only with contact
-facets). Without h5py the data is written inline in the XDMF files."""
+contact facets (only with contact facets) with cell data beta and point
+data u, and at the contact nodes (0 elsewhere, e.g. at a node that left
+Γ_C): traction (global, 3 components), normal_traction (positive in
+compression), tangential_traction (nodal tangent frames, padded to 3),
+u_normal, slip |u_τ|, on_wall (0/1) and state, an integer: 0 separated,
+1 compliance, 2 wall, 3 stick, 4 slip
+(:func:`adhesive_contact.postprocess.contact_state_code`). Without h5py the data is written inline in the XDMF files."""
 
 from pathlib import Path
 
 import meshio
 import numpy as np
 
-from ..postprocess import stress_3x3, von_mises
+from ..postprocess import contact_fields, stress_3x3, von_mises
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 REOPEN = 100   # levels between reopenings of the HDF5 file
@@ -71,11 +76,13 @@ def contact_facets(problem):
 class XdmfSeries:
     """The open time series of one run in ``folder``: :meth:`write` one
     level at a time (anything with ``t``, ``u`` (npoints, d), ``stress``,
-    ``stress_zz`` and ``beta``, e.g. a :class:`~adhesive_contact.scheme.state.Level`),
+    ``stress_zz``, ``beta``, ``contact_force``, ``frame_displacement``,
+    ``on_wall`` and ``stuck``, e.g. a :class:`~adhesive_contact.scheme.state.Level`),
     then :meth:`close`. ``names`` lists the files."""
 
     def __init__(self, problem, folder):
         mesh, d = problem.mesh, problem.dim
+        self.problem = problem
         folder = Path(folder)
         fmt = data_format()
         h5 = fmt == "HDF"
@@ -95,8 +102,25 @@ class XdmfSeries:
                              cell_data={"stress": [stress.reshape(-1, 9)],
                                         "von_mises": [von_mises(stress)]})
         if self.contact is not None:
-            self.contact.write_data(float(level.t), point_data={"u": u},
+            self.contact.write_data(float(level.t), point_data={"u": u, **self._nodal(level)},
                                     cell_data={"beta": [np.asarray(level.beta)]})
+
+    def _nodal(self, level):
+        """The contact fields of a level at every mesh point (0 off Γ_C's nodes)."""
+        nodes = self.problem.boundary.nodes
+        npoints = self.problem.mesh.p.shape[1]
+        fields = contact_fields(self.problem, level.contact_force, level.frame_displacement,
+                                level.on_wall, level.stuck)
+        fields["on_wall"] = np.asarray(level.on_wall, dtype=float)
+        out = {}
+        for name, values in fields.items():
+            values = np.asarray(values, dtype=float)
+            if values.ndim == 2:
+                values = pad_vectors(values)
+            full = np.zeros((npoints, *values.shape[1:]))
+            full[nodes] = values
+            out[name] = full
+        return out
 
     def close(self):
         for writer in (self.body, self.contact):
@@ -109,6 +133,9 @@ class _LevelOf:
 
     def __init__(self, solution, n):
         self.t, self.u, self.beta = solution.t[n], solution.u[n], solution.beta[n]
+        self.contact_force = solution.contact_force[n]
+        self.frame_displacement = solution.frame_displacement[n]
+        self.on_wall, self.stuck = solution.on_wall[n], solution.stuck[n]
         self.stress = solution.stress[n]
         self.stress_zz = None if solution.stress_zz is None else solution.stress_zz[n]
 

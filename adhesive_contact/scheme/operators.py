@@ -2,7 +2,8 @@
 
 The system is written in the nodal frames of Γ_C, ũ = Rᵀ u
 (:meth:`~adhesive_contact.contact_boundary.ContactBoundary.rotation`), and
-restricted to the free dofs. Two step matrices serve the whole run
+restricted to the free dofs; the held dofs (never at Γ_C, never rotated)
+enter through the coupling block a_FD, built once per step matrix. Two step matrices serve the whole run
 (:mod:`adhesive_contact.scheme.condensed`):
 
 - a_n = A + k R(0) for n ≥ 1 (the j = n term of the right rectangle rule
@@ -29,6 +30,7 @@ class StepOperators:
     initial: CondensedOperator   # A, for t = 0
     step: CondensedOperator      # A + k R(0), for n ≥ 1
     tensors: tuple               # (λ, μ) of A and of A + k R(0)
+    support: tuple               # per tensor (a_FD (nF, nD), a_D· (nD, ndofs)), built once
     factor_seconds: float
     schur_seconds: float
 
@@ -61,10 +63,15 @@ class StepOperators:
             solver.reason = reason
             return solver
 
+        fixed = problem.prescribed.fixed
+        support = {}   # (λ, μ) -> (a_FD, a_D·): the coupling and the held rows
+
         def condensed(lam, mu, approximation=None):
             A = assembly.stiffness(lam, mu)
             if R is not None:
                 A = (R.T @ A @ R).tocsr()
+            rows = A[fixed]     # the held dofs are not rotated: rows of a_n in Cartesian u
+            support[(lam, mu)] = (rows[:, free].T.tocsr(), rows)
             A = A[free][:, free]
             if method == "pardiso" and contact.size:   # S and the solve halves in one
                 operator = PartialCondensation(A, contact)
@@ -84,7 +91,7 @@ class StepOperators:
             *elastic, approximation=approximation)
         schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
         return cls(rotation=R, free=free, initial=initial, step=step,
-                   tensors=(elastic, stepped),
+                   tensors=(elastic, stepped), support=(support[elastic], support[stepped]),
                    factor_seconds=time.perf_counter() - t0, schur_seconds=schur)
 
     def at(self, n):
@@ -94,6 +101,18 @@ class StepOperators:
     def tensor(self, n):
         """(λ, μ) of the step matrix of level n."""
         return self.tensors[0] if n == 0 else self.tensors[1]
+
+    def lift(self, n, g):
+        """a_FD g_D: the force of the held values g (nD,) on the free dofs of level n."""
+        return self.support[0 if n == 0 else 1][0] @ g
+
+    def reaction(self, n, u_frame, f):
+        """The nodal reactions r_D = (a_n u)_D − f_D of level n on the held
+        dofs: the force the support exerts on the body, from the whole
+        nodal-frame ũ (ndofs,) (the rows of Rᵀ a_n R at the unrotated held
+        dofs are those of a_n R) and the load f_D on the held dofs (the
+        memory history subtracted)."""
+        return self.support[0 if n == 0 else 1][1] @ u_frame - f
 
     def to_frames(self, f):
         """A load vector (ndofs,) in nodal frames, restricted to the free dofs."""

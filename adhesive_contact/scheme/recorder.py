@@ -29,6 +29,7 @@ class HistoryRecorder:
             "on_wall": np.zeros((levels, nc), dtype=bool),
             "stuck": np.zeros((levels, nc), dtype=bool),
             "probes": np.zeros((levels, nprobes, d)),
+            "reaction": np.zeros((levels, problem.prescribed.fixed.size)),
             "iterations": np.zeros(levels, dtype=int),
             "residual": np.zeros(levels),
         }

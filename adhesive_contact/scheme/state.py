@@ -45,6 +45,7 @@ class Level:
     on_wall: np.ndarray           # (nc,) bool
     stuck: np.ndarray             # (nc,) bool
     probes: np.ndarray            # (nprobes, d)
+    reaction: np.ndarray          # (nD,) force of the support on the body per held dof
     iterations: int
     residual: float
 
@@ -118,24 +119,44 @@ def bonding_step(problem, state):
     return advance(problem.scene.contact.integrator, rate, state.beta, problem.scene.k)
 
 
+@dataclass
+class KnownPart:
+    """What level n knows before its solve, besides the free-dof load:
+    the memory history's (a_λ, a_μ) fields (None at n = 0 and while the
+    history is zero), the held values g_D(t_n) and the load f_D − (history
+    force)_D on the held dofs (for the reactions)."""
+
+    history: tuple
+    prescribed: np.ndarray
+    held_load: np.ndarray
+
+
 def step_load(problem, operators, state, n, t):
     """The load of level n on the free dofs in nodal frames: f(t_n) minus
-    the force of the memory history k Σ_{j<n} R(t_n − t_j) ε(u_j); and the
-    history's (a_λ, a_μ) fields (None at n = 0 and while the history is zero)."""
+    the force of the memory history k Σ_{j<n} R(t_n − t_j) ε(u_j) (u_j the
+    whole displacement, held part included), minus the force a_FD g_D(t_n)
+    of the held values; and the :class:`KnownPart` of the level."""
     f = problem.loads(t)
     history = state.memory.history(n) if n >= 1 else None
     if history is not None:
         f -= problem.assembly.force(*history)
-    return operators.to_frames(f), history
+    held = problem.prescribed
+    g = held.values(t)
+    b = operators.to_frames(f)
+    if not held.is_zero:
+        b -= operators.lift(n, g)
+    return b, KnownPart(history, g, f[held.fixed])
 
 
-def step_solve(problem, operators, contact, n, t, b, beta, history, z0):
+def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     """(4.1) at level n: the nonsmooth problem on the contact unknowns, then
-    the interior by back substitution, the stress
-    σ_n = C ε(u_n) + k R(0) ε(u_n) + history and the contact reactions.
+    the interior by back substitution, the held values g_D(t_n) put in, the
+    stress σ_n = C ε(u_n) + k R(0) ε(u_n) + history, the contact reactions
+    and the reactions of the held dofs.
 
     Returns ``(level, u, frame_u, z, result)``; ``result`` is the
     :class:`~adhesive_contact.step_methods.StepResult` (None without Γ_C)."""
+    history = known.history
     step = operators.at(n)
     c = step.reduce(b)
     d = problem.dim
@@ -156,6 +177,7 @@ def step_solve(problem, operators, contact, n, t, b, beta, history, z0):
             stuck = result.stuck
     u_frame = np.zeros(problem.ndofs)
     u_frame[operators.free] = step.expand(z, b)
+    u_frame[problem.prescribed.fixed] = known.prescribed   # held dofs are never rotated
     frame_u = u_frame[problem.boundary.dofs.ravel()] if nc else np.zeros(0)
     u = operators.from_frames(u_frame)
 
@@ -170,6 +192,7 @@ def step_solve(problem, operators, contact, n, t, b, beta, history, z0):
         contact_force=force, frame_displacement=frame_u.reshape(nc, d), on_wall=on_wall,
         stuck=stuck, probes=(problem.probe_map @ points if problem.probe_map is not None
                              else np.zeros((0, d))),
+        reaction=operators.reaction(n, u_frame, known.held_load),
         iterations=0 if result is None else result.nit,
         residual=0.0 if result is None else result.residual)
     return level, u, frame_u, z, result
