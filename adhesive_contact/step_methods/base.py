@@ -140,3 +140,23 @@ def stationarity(S, c, energy, upper, z, kink):
                 np.abs(gphi).max(initial=0.0), kappa.max(initial=0.0), 1e-300)
     return Stationarity(g=g, Sz=Sz, xi=xi, s=s, at_zero=at_zero, unit=unit, h=h, hn=hn, pg=pg,
                         wall=wall, scale=scale, residual=np.abs(pg).max(initial=0.0))
+
+
+def backtrack(directions, trial_of, total, bound, halvings=60):
+    """Armijo backtracking along each direction in turn: α = 1, ½, ¼, …
+    until ``total(trial) <= bound(direction, trial, α)``, with ``trial =
+    trial_of(direction, α)``. Returns ``(trial, total(trial))``, or None
+    when no direction gives a decrease; a ``bound`` of None skips a
+    direction (not one of descent)."""
+    for direction in directions:
+        alpha = 1.0
+        for _ in range(halvings):
+            trial = trial_of(direction, alpha)
+            limit = bound(direction, trial, alpha)
+            if limit is None:
+                break
+            E_trial = total(trial)
+            if E_trial <= limit:
+                return trial, E_trial
+            alpha *= 0.5
+    return None

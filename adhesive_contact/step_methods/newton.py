@@ -53,6 +53,7 @@ from .base import (
     MESSAGES,
     Kink,
     StepResult,
+    backtrack,
     no_kink,
     stationarity,
 )
@@ -179,22 +180,12 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
                 break
             z, E = trial, E_trial
             continue
-        found = False
-        for direction in (d, gradient_step):
-            alpha = 1.0
-            for _ in range(60):
-                trial = project(z + alpha * direction)
-                E_trial = total(trial)
-                if E_trial <= E + sigma * slope(trial - z) + slack:
-                    found = True
-                    break
-                alpha *= 0.5
-            if found:
-                break
-        if not found:
+        accepted = backtrack((d, gradient_step), lambda dz, a: project(z + a * dz), total,
+                             lambda dz, trial, a: E + sigma * slope(trial - z) + slack)
+        if accepted is None:
             status = LINE_SEARCH_FAILED
             break
-        z, E = trial, E_trial
+        z, E = accepted
     # one exit: the wall multipliers and sets of the last iterate z
     message = MESSAGES[status].format(max_iter=max_iter, nit=it)
     if inner_failures:

@@ -25,7 +25,15 @@ and to the size of the body (:mod:`adhesive_contact.scheme.state`).
 import numpy as np
 import scipy.sparse as sp
 
-from .base import CONVERGED, LINE_SEARCH_FAILED, MAX_ITERATIONS, MESSAGES, StepResult, no_kink
+from .base import (
+    CONVERGED,
+    LINE_SEARCH_FAILED,
+    MAX_ITERATIONS,
+    MESSAGES,
+    StepResult,
+    backtrack,
+    no_kink,
+)
 
 
 class SmoothedContact:
@@ -124,25 +132,15 @@ def minimise(S, c, energy, upper, z0, options, kink=None, sigma=1e-4):
         d, converged = S.newton_solve(phi.hessian(z), -g, free)
         inner_failures += not converged
         slack = 1e-13 * (abs(E) + 0.5 * abs(z @ Sz) + abs(c @ z) + 1e-300)
-        found = False
-        for direction in (d, -g / diag):
+        def bound(direction, trial, alpha):
             slope = g @ direction
-            if not slope < 0:
-                continue
-            alpha = 1.0
-            for _ in range(60):
-                trial = z + alpha * direction
-                E_trial = total(trial)
-                if E_trial <= E + sigma * alpha * slope + slack:
-                    found = True
-                    break
-                alpha *= 0.5
-            if found:
-                break
-        if not found:
+            return E + sigma * alpha * slope + slack if slope < 0 else None
+
+        accepted = backtrack((d, -g / diag), lambda dz, a: z + a * dz, total, bound)
+        if accepted is None:
             status = LINE_SEARCH_FAILED
             break
-        z, E = trial, E_trial
+        z, E = accepted
     violation = phi._violation(z)
     s = np.linalg.norm(z[kink.tangential], axis=1) if kink.tangential.size else np.zeros(0)
     message = MESSAGES[status].format(max_iter=options.max_iter, nit=it)
