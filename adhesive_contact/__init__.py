@@ -1,7 +1,7 @@
 """adhesive_contact: quasistatic adhesive contact of a viscoelastic body with
 long memory, solved with the fully discrete scheme of Cheng & Xiao
 (P1 displacements, P0 bonding on Γ_C, right rectangle memory, explicit
-Euler bonding) on scikit-fem. See MODEL.md for the mathematics."""
+Euler bonding) on scikit-fem. See docs/model.md for the mathematics."""
 
 from .expressions import ExpressionError, compile_expression
 from .io import write_xdmf

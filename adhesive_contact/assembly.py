@@ -6,7 +6,7 @@ An isotropic tensor C ε = λ tr(ε) I + 2 μ ε has the stiffness
     K_λ = ∫_Ω div u div v,        K_μ = ∫_Ω 2 ε(u) : ε(v),
 
 so the elastic tensor A, the memory tensors C_m and the step matrix
-a_n = A + k R(0) of MODEL.md §5 are all combinations of two matrices
+a_n = A + k R(0) of docs/scheme.md ('What a step solves') are all combinations of two matrices
 assembled once. Loads ⟨f(t), v⟩ = (f_0, v)_Ω + (f_N, v)_{Γ_N} are a fixed
 sparse map applied to the load expressions evaluated at fixed quadrature
 points, so a step costs one evaluation and one sparse product.

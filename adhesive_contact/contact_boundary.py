@@ -6,7 +6,7 @@ clamped) written in a local orthonormal frame per node,
 
     u_a = R_a z_a,   R_a = [ν_a, τ_a (, τ'_a)],
 
-so that z_{a,0} = u_ν(x_a) and the wall u_ν ≤ g of K^h (MODEL.md §4) is a
+so that z_{a,0} = u_ν(x_a) and the wall u_ν ≤ g of K^h (docs/scheme.md) is a
 bound on one coordinate. ν_a is the length-weighted average of the outward
 normals of the facets around node a.
 
@@ -14,7 +14,7 @@ Contact integrals ∫_{Γ_C} φ(β, u_ν, u_τ) are replaced by a quadrature
 Σ_q w_q φ(β_{f(q)}, (N z)_q, (T z)_q) over points q of the contact facets,
 with β the P0 value of the facet f(q) holding q:
 
-- ``nodal`` (the default, SPEC.md): the trapezoid rule on each facet, its
+- ``nodal`` (the default, docs/scenes.md): the trapezoid rule on each facet, its
   points being the facet's vertices (weights |f|/d each) and u_ν, u_τ being
   the nodal components z_a; the terms then split node by node;
 - ``gauss``: a Gauss rule of the given exactness on each facet, with u the

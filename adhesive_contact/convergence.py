@@ -1,4 +1,4 @@
-"""Convergence studies in h, k or both (MODEL.md §7).
+"""Convergence studies in h, k or both (docs/verification.md).
 
 A study refines a scene level by level — ``"h"``: one uniform (nested)
 mesh refinement per level; ``"k"``: the step halved per level; ``"hk"``:

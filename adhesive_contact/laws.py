@@ -1,4 +1,4 @@
-"""Contact laws of MODEL.md §6, one small object per law.
+"""Contact laws of docs/model.md §4, one small object per law.
 
 Normal laws are functions of the bonding β and of the normal displacement
 r = u_ν (positive towards the foundation):
@@ -91,7 +91,7 @@ class NormalCompliance:
 
 @dataclass(frozen=True)
 class AdhesiveCompliance:
-    """p_ν(β, r) = c r_+ − γ β² R_ν(r) (MODEL.md §6).
+    """p_ν(β, r) = c r_+ − γ β² R_ν(r) (docs/model.md §4).
 
     Compression pushes back with stiffness c; a bonded, separated surface
     is pulled back by the glue up to a separation L. The potential is
@@ -231,7 +231,7 @@ class PowerLaw:
 
 @dataclass(frozen=True)
 class AdhesiveSpring:
-    """The glue's tangential spring: ∇j_τ = γ β² R_τ(ξ) (MODEL.md §6).
+    """The glue's tangential spring: ∇j_τ = γ β² R_τ(ξ) (docs/model.md §4).
 
     φ(β, s) = γ β² s²/2 for s ≤ L and γ β² (L s − L²/2) beyond, so the
     tangential traction is capped at γ β² L; convex in ξ. The constant of
@@ -315,7 +315,7 @@ class FrictionSum:
 
 @dataclass(frozen=True)
 class Fremond:
-    """F(r, ξ, β) = −(β (γ_ν R_ν(r)² + γ_τ |R_τ(ξ)|²) − ε_a)_+ (MODEL.md §6).
+    """F(r, ξ, β) = −(β (γ_ν R_ν(r)² + γ_τ |R_τ(ξ)|²) − ε_a)_+ (docs/model.md §4).
 
     β is clamped to [0, 1] inside F, so F is globally Lipschitz, F(·,·,0) = 0
     (ε_a ≥ 0), F ≤ 0 always (so F ≤ 0 for β ≥ 1 and β never increases) and

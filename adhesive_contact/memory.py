@@ -7,7 +7,7 @@ strain of a displacement-like field, so it is stored as two nodal vectors
 (a_λ, a_μ) whose force is K_λ a_λ + K_μ a_μ and whose stress is
 tr ε(a_λ) I + 2 ε(a_μ) (see :mod:`adhesive_contact.assembly`).
 
-- Prony series R(t) = Σ_m e^{−t/τ_m} C_m (MODEL.md §6): with
+- Prony series R(t) = Σ_m e^{−t/τ_m} C_m (docs/model.md §4): with
   h_n^m = k Σ_{j<n} e^{−(t_n−t_j)/τ_m} u_j one has h_1^m = 0 and
   h_n^m = e^{−k/τ_m} (h_{n−1}^m + k u_{n−1}) exactly: O(1) per step.
 - A relaxation modulus G(t) = C_∞ + Σ_i e^{−t/τ_i} C_i is the Prony series

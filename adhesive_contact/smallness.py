@@ -1,4 +1,4 @@
-"""The smallness conditions of MODEL.md §2, estimated per scene:
+"""The smallness conditions of docs/model.md §3, estimated per scene:
 
     existence and uniqueness   m_A > max{√3 c_1τ, m_τ} c_e²‖γ‖² + m_ν c_e²‖γ‖²,
     the error estimate         m_A > (m_τ + m_ν) c_e²‖γ‖²,
@@ -23,7 +23,7 @@ estimate also of the run mesh's constant, so the conditions are then
 optimistic). m_ν, m_τ and c_1τ are the constants of the scene's laws.
 The condition is
 sufficient, not necessary: convex laws give a unique discrete solution
-whatever it says: the step energy of MODEL.md §5 is strictly convex as
+whatever it says: the step energy of docs/scheme.md ('What a step solves') is strictly convex as
 soon as m_A > m_c c_e²‖γ‖², m_c the nonconvexity of the friction
 (α (a − b) for slip weakening, 0 for every other law of §6), which is
 reported too.

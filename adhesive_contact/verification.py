@@ -1,4 +1,4 @@
-"""Errors of MODEL.md §7, nested prolongation, and fitted rates.
+"""Errors of docs/verification.md, nested prolongation, and fitted rates.
 
 Errors are measured as in the estimates: e_u(t_n) = ‖ε(u(t_n) − u_n^h)‖_{L²(Ω)},
 e_β(t_n) = ‖β(t_n) − β_n^h‖_{L²(Γ_C)}, E_n = e_u + e_β, and each reported as

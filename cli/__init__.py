@@ -1,4 +1,4 @@
-"""adhesive_contact_cli: the ``adhcontact`` command line (SPEC.md, "Command line").
+"""adhesive_contact_cli: the ``adhcontact`` command line (docs/outputs.md).
 
 A thin layer over :mod:`adhesive_contact`: :mod:`.main` parses arguments,
 reads the scene, calls the library and reports errors in one line;

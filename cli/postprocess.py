@@ -17,7 +17,7 @@ def _vector(values):
 def smallness_record(problem):
     """``problem.smallness`` as plain JSON (None without contact terms).
 
-    The terms of MODEL.md §2's condition m_A > (m_τ + m_ν) c_e²‖γ‖²: numbers,
+    The terms of docs/model.md §3's condition m_A > (m_τ + m_ν) c_e²‖γ‖²: numbers,
     and the booleans ``holds`` and ``step_energy_convex``."""
     small = problem.smallness
     if small is None:

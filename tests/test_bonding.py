@@ -1,4 +1,4 @@
-"""The bonding field β (MODEL.md §4, §6): the Frémond law integrated by
+"""The bonding field β (docs/scheme.md, §6): the Frémond law integrated by
 explicit Euler (4.2),
 
     β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}),

@@ -1,5 +1,5 @@
 """The step solver against an independent minimisation of the same discrete
-energy (MODEL.md §5) with scipy's L-BFGS-B, and the sign and
+energy (docs/scheme.md ('What a step solves')) with scipy's L-BFGS-B, and the sign and
 complementarity of the wall multiplier.
 
 Setting: [0, 2] x [0, 0.5], 16 x 8 cells, top (or left) clamped, bottom = Γ_C with

@@ -1,4 +1,4 @@
-"""Tests for ``adhcontact converge`` (SPEC.md, "Command line (firm)"; MODEL.md §7):
+"""Tests for ``adhcontact converge`` (docs/outputs.md; docs/verification.md):
 the firm outputs, the fine reference, resuming, refusing another study and
 running levels in parallel. Tiny scenes (4x2 cells, a few steps, 3 levels)."""
 

@@ -1,4 +1,4 @@
-"""Friction (MODEL.md §5–§6) against independent computations.
+"""Friction (docs/scheme.md ('What a step solves')–§6) against independent computations.
 
 Setting: [0, 2] x [0, 0.5], 16 x 4 cells, top clamped, bottom = Γ_C with
 ν = (0, −1), τ = (1, 0), so u_ν = −u_y and u_τ = u_x at the contact nodes.
@@ -8,7 +8,7 @@ Tresca and slip-weakening friction hold the nodes near x = 0 (stick,
 u_τ = 0) and let those near x = 2 slip. One time step, no memory, β ≡ 1.
 
 With the nodal rule each contact node a carries the weight
-w_a = Σ_{facets f ∋ a} |f|/2 and the step (MODEL.md §5) minimises, over the
+w_a = Σ_{facets f ∋ a} |f|/2 and the step (docs/scheme.md ('What a step solves')) minimises, over the
 free dofs u,
 
     J(u) = ½ uᵀ K u − fᵀ u + Σ_a w_a [P_ν(−u_{y,a}) + φ(|u_{x,a}|)],
@@ -56,7 +56,7 @@ def scene(friction, body, normal=None, steps=1, solver=None):
 
 
 # --------------------------------------------------------------------------
-# The laws, written here from MODEL.md §6 (not imported from the library).
+# The laws, written here from docs/model.md §4 (not imported from the library).
 # Each gives h(s), h'(s) and the increment h(s0 + ds) − h(s0) computed
 # without forming h(s0) (see Reference._increment): by default the integral
 # of h' over [s0, s0 + ds], Gauss–Legendre (8 points, exact to degree 15) on

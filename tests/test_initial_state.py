@@ -1,4 +1,4 @@
-"""u_0 solves the t = 0 problem with the elastic stiffness alone (MODEL.md §4).
+"""u_0 solves the t = 0 problem with the elastic stiffness alone (docs/scheme.md).
 
 With memory the t = 0 Schur complement is applied, not formed, and the
 Newton systems are solved by CG preconditioned with the Schur complement of

@@ -1,9 +1,9 @@
-"""The contact laws of MODEL.md §6 against independent computations.
+"""The contact laws of docs/model.md §4 against independent computations.
 
 Every check compares a law's method with something computed here without
 that method: finite differences of another method, quadrature of the law's
-formula as MODEL.md states it, random sampling of the hypotheses of
-MODEL.md §2, or a hand-derived constant.
+formula as docs/model.md states it, random sampling of the hypotheses of
+docs/model.md §3, or a hand-derived constant.
 
 Tolerances. A central difference (f(x+h) − f(x−h))/(2h) differs from f'(x)
 by at most h²/6 · sup|f'''| on [x−h, x+h] (Taylor), plus the rounding of
@@ -151,7 +151,7 @@ def test_normal_derivative_is_the_derivative_of_the_value(law, beta):
 
 @pytest.mark.parametrize("law", NORMAL, ids=repr)
 def test_normal_value_matches_model_formula(law):
-    # MODEL.md §6: p_ν = c r_+ − γ β² R_ν(r), written here scalar by scalar.
+    # docs/model.md §4: p_ν = c r_+ − γ β² R_ν(r), written here scalar by scalar.
     rng = np.random.default_rng(2)
     r = rng.uniform(-3, 2, 300)
     beta = rng.uniform(0, 1, 300)
@@ -324,7 +324,7 @@ def test_dphi_and_ddphi_are_derivatives(law, beta):
 
 
 def test_phi_matches_model_formulas():
-    # φ(s) = ∫_0^s μ(t) dt with μ(t) = (a − b) e^{−αt} + b (MODEL.md §6),
+    # φ(s) = ∫_0^s μ(t) dt with μ(t) = (a − b) e^{−αt} + b (docs/model.md §4),
     # by Gauss-Legendre with 30 nodes (exact to rounding for this entire integrand)
     law = SlipWeakening(a=0.8, b=0.3, alpha=4.0)
     x, w = np.polynomial.legendre.leggauss(30)
@@ -480,7 +480,7 @@ def test_slip_weakening_is_relaxed_monotone_with_sharp_constant():
 
 
 def test_adhesive_spring_is_relaxed_monotone_in_beta_and_xi():
-    # MODEL.md §2 with the β dependence: (∇j(β1, ξ1) − ∇j(β2, ξ2))·(ξ1 − ξ2)
+    # docs/model.md §3 with the β dependence: (∇j(β1, ξ1) − ∇j(β2, ξ2))·(ξ1 − ξ2)
     # ≥ −m_τ (|β1 − β2| + |ξ1 − ξ2|) |ξ1 − ξ2|, m_τ = 2γL
     law = AdhesiveSpring(gamma=2.0, L=0.8)
     fs = FrictionSum((law,))
@@ -546,7 +546,7 @@ def test_fremond_rate_signs_and_formula(law, d1):
     rng = np.random.default_rng(9)
     r, xi, beta = fremond_samples(law, rng, 3000, d1)
     F = law.rate(r, xi, beta)
-    # F(r, ξ, β) of MODEL.md §6, scalar by scalar, β clamped to [0, 1]
+    # F(r, ξ, β) of docs/model.md §4, scalar by scalar, β clamped to [0, 1]
     expected = []
     for ri, xii, bi in zip(r, xi, beta):
         sn = min(max(-ri, 0.0), law.L)

@@ -1,4 +1,4 @@
-"""Verification machinery (MODEL.md §7): manufactured data, nested
+"""Verification machinery (docs/verification.md): manufactured data, nested
 prolongation, errors and rates on small levels."""
 
 from dataclasses import replace

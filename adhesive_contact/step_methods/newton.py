@@ -2,7 +2,7 @@
 semismooth Newton method for the step of (4.1) on the contact unknowns.
 
 With the interior condensed out (:mod:`adhesive_contact.scheme.condensed`), a step
-minimises the energy of MODEL.md §5 over the contact unknowns z,
+minimises the energy of docs/scheme.md ('What a step solves') over the contact unknowns z,
 
     E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z_ν ≤ g  (the wall),
 

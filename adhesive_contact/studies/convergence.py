@@ -1,4 +1,4 @@
-"""Convergence studies in h, k or both, kept in a folder (MODEL.md §7).
+"""Convergence studies in h, k or both, kept in a folder (docs/verification.md).
 
 The computation of one level and of the fine reference is
 :mod:`adhesive_contact.convergence`; :class:`ConvergenceStudy` is the
@@ -56,7 +56,7 @@ FLOAT_KEYS = ("h", "k", "err_u", "err_beta", "E", "seconds")
 RECORD_KEYS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "seconds")
 CSV_COLUMNS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
                "seconds")
-#: MODEL.md §7: a rate is fitted over at least 4 levels
+#: docs/verification.md: a rate is fitted over at least 4 levels
 MEANINGFUL_LEVELS = 4
 #: the largest run a study may ask for (dofs); beyond it the set-up alone
 #: (a Schur complement onto Γ_C) takes hours and tens of GB on a workstation

@@ -4,7 +4,7 @@
 
 reads ``results/*/rates.json`` beside this script (as written by
 ``adhcontact converge``) and prints one row per study: the observed
-least-squares rates against the theoretical 1 of MODEL.md §4.
+least-squares rates against the theoretical 1 of docs/scheme.md.
 """
 
 import json
