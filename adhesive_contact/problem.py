@@ -29,6 +29,7 @@ from .memory import make_memory
 from .mesh import build_mesh
 from .scene import SIDES, SceneError
 from .smallness import smallness
+from .value_checks import check_exact, check_kernel, check_loads
 
 
 @dataclass(kw_only=True)
@@ -133,6 +134,8 @@ def build_problem(scene):
     position[free] = np.arange(free.size)
 
     times = scene.k * np.arange(scene.steps + 1)
+    if scene.memory is not None and scene.memory.kernel == "function":
+        check_kernel("memory.r", scene.memory.function, scene.k, scene.steps)
     friction = make_friction(scene.contact.friction)
     boundary, gap, beta0 = None, None, np.zeros(0)
     columns = contact_positions = np.zeros(0, dtype=np.int64)
@@ -186,8 +189,17 @@ def build_problem(scene):
         body = None if is_zero(scene.body) else vector_of(scene.body)
         surface = [(mesh.boundaries[side], vector_of(exprs))
                    for side, exprs in scene.traction.items()]
+        checks = ([] if body is None else
+                  [[(f"loads.body[{i}]", e) for i, e in enumerate(scene.body)]])
+        checks += [[(f"loads.traction.{side}[{i}]", e) for i, e in enumerate(exprs)]
+                   for side, exprs in scene.traction.items()]
     else:
-        exact = ManufacturedSolution(scene, normal_law, friction, bonding)
+        check_exact(scene.exact, mesh.p, times)
+        try:
+            exact = ManufacturedSolution(scene, normal_law, friction, bonding)
+        except (ArithmeticError, ValueError, TypeError, KeyError) as err:
+            raise SceneError("exact", "the loads cannot be derived from the exact solution "
+                             f"({type(err).__name__}: {err})") from None
         body = exact.body_force
         neumann = [s for s in SIDES[d] if s not in scene.dirichlet + scene.contact_sides]
         surface = [(mesh.boundaries[side], exact.traction(_side_normal(side, d)[:, None]))
@@ -202,6 +214,9 @@ def build_problem(scene):
             beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
             beta0 = _facet_mean(mesh, boundary, exact.beta)
     loads = LoadMap(mesh, body, surface)
+    if scene.exact is not None:
+        checks = [[("exact", field)] for field, _, _ in loads.parts]
+    check_loads(checks, loads, times)
     return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free, boundary=boundary,
                    columns=columns, contact_positions=contact_positions, loads=loads, gap=gap,
                    beta0=beta0, normal_law=normal_law, friction=friction, bonding=bonding,
