@@ -30,7 +30,7 @@ from adhesive_contact.studies import (
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
 
 from .common import CliError, echo_warnings, load_scene, read_scene
-from .plots import DPI
+from .plots import DPI, plot_title
 
 # ---------------------------------------------------------------- the table
 
@@ -82,7 +82,7 @@ def _reference_phrase(info):
 
 
 def _suptitle(fig, document, title):
-    wrapped = textwrap.fill(title, 70)
+    wrapped = textwrap.fill(plot_title(title), 70)
     fig.suptitle(f"{wrapped}\n{document['param']}-refinement, {len(document['levels'])} "
                  f"levels; {_reference_phrase(document['reference'])}", fontsize="medium")
 

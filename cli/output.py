@@ -6,7 +6,8 @@ half-written ``DIR`` and a user's own files in ``DIR`` are never touched:
 
 - ``summary.json``: resolved scene, mesh counts, the smallness terms of
   MODEL.md §2 (null without contact), the warnings of the problem, timings,
-  iterations and one record per time level (:func:`~.postprocess.step_records`);
+  the estimated resources beside those used (``resources``), iterations
+  and one record per time level (:func:`~.postprocess.step_records`);
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
 - ``solution.xdmf`` + ``solution.h5``: time series for ParaView with point
   data u (3 components) and cell data stress (3×3 flattened) and von_mises
@@ -18,7 +19,9 @@ half-written ``DIR`` and a user's own files in ``DIR`` are never touched:
 - PNG plots (:mod:`.plots`).
 """
 
+import glob
 import os
+import resource
 import shutil
 import tempfile
 from pathlib import Path
@@ -27,6 +30,7 @@ import meshio
 import numpy as np
 
 from adhesive_contact.postprocess import stress_3x3, von_mises
+from adhesive_contact.resources import estimate
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 
@@ -89,8 +93,23 @@ def summary(solution):
         "warnings": [str(w) for w in problem.warnings()],
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
+        "resources": resources_record(solution),
         "iterations": [int(i) for i in solution.iterations],
         "steps": step_records(solution),
+    }
+
+
+def resources_record(solution):
+    """The estimate made from the scene before the run
+    (:func:`adhesive_contact.resources.estimate`) beside what was used."""
+    problem = solution.problem
+    return {
+        "estimate": estimate(problem.scene).record(),
+        "used": {"dofs": int(problem.ndofs), "contact_unknowns": int(problem.columns.size),
+                 "levels": int(solution.t.size), "backend": solution.linear.get("method"),
+                 "seconds": json_number(solution.timings.get("total", float("nan"))),
+                 "peak_memory_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+                 * 1024},
     }
 
 
@@ -195,7 +214,31 @@ def _publish(staging, target):
     staging.rmdir()
 
 
-def write_outputs(solution, out):
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:       # another user's process: alive
+        return True
+    return True
+
+
+def remove_stale(folder, prefix):
+    """Remove the staging folders ``<prefix><pid>-XXXX`` in ``folder`` left by
+    runs that were killed (their process ``pid`` no longer exists); return
+    their names. A staging folder of a live run, or one named otherwise,
+    stays."""
+    removed = []
+    for path in Path(folder).glob(f"{glob.escape(prefix)}*-*"):
+        pid = path.name[len(prefix):].split("-", 1)[0]
+        if path.is_dir() and pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(path, ignore_errors=True)
+            removed.append(path.name)
+    return removed
+
+
+def write_outputs(solution, out, failures=None):
     """Write all outputs of a solve into folder ``out``, atomically.
 
     Parameters
@@ -203,23 +246,31 @@ def write_outputs(solution, out):
     solution : adhesive_contact.Solution
     out : path of the output folder; its parents are created. In an
         existing folder only the files of :data:`OUTPUT_NAMES` are replaced
-        (see :func:`_publish`); a user's other files stay.
+        (see :func:`_publish`); a user's other files stay. The files are
+        staged in a folder named after this process (``<out>.tmp-<pid>-*``
+        beside a new ``out``, ``.adhcontact.tmp-<pid>-*`` inside an existing
+        one); those of killed runs are removed first (:func:`remove_stale`).
 
     Returns
     -------
     list of str : the names of the files written, sorted.
+
+    A plot that cannot be drawn is left out and named in ``failures`` (a
+    list), if given; the data files are written all the same.
     """
     out = Path(out).absolute()
     if out.is_dir():   # staged inside, so that os.replace stays on one file system
-        tmp = Path(tempfile.mkdtemp(prefix=".adhcontact.tmp-", dir=out))
+        remove_stale(out, ".adhcontact.tmp-")
+        tmp = Path(tempfile.mkdtemp(prefix=f".adhcontact.tmp-{os.getpid()}-", dir=out))
     else:
         out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-", dir=out.parent))
+        remove_stale(out.parent, f"{out.name}.tmp-")
+        tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-{os.getpid()}-", dir=out.parent))
     try:
         write_summary(solution, tmp / "summary.json")
         write_npz(solution, tmp / "solution.npz")
         write_xdmf(solution, tmp)
-        plots.write_plots(solution, tmp)
+        plots.write_plots(solution, tmp, failures)
         names = sorted(p.name for p in tmp.iterdir())
         _publish(tmp, out)
     except BaseException:

@@ -26,7 +26,7 @@ from adhesive_contact.studies import (
 from adhesive_contact.studies.sweep import show
 
 from .common import CliError, load_scene, read_scene
-from .plots import DPI
+from .plots import DPI, plot_title
 
 #: the panels of each figure: (runs.csv column, axis label)
 PANELS = (("seconds", "wall time of the run (s)"),
@@ -83,7 +83,7 @@ def plot_key(path, rows, keys, key, title):
                    title="other settings", ncols=min(3, len(groups)))
     failed = sum(row["outcome"] != "ok" for row in rows)
     note = f"; × on the time panel: {failed} failed run(s)" if failed else ""
-    fig.suptitle(f"{title}\nsweep over {key}{note}", fontsize="medium")
+    fig.suptitle(f"{plot_title(title)}\nsweep over {key}{note}", fontsize="medium")
     write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI), binary=True)
     plt.close(fig)
 
