@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 import numpy as np
 from matplotlib.ticker import NullFormatter  # noqa: E402
 
-from adhesive_contact.convergence import PARAMS
+from adhesive_contact.convergence import PARAMS, level_scene
 from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     ConvergenceStudy,
@@ -29,7 +29,7 @@ from adhesive_contact.studies import (
 )
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
 
-from .common import CliError, echo_warnings, load_scene, read_scene
+from .common import CliError, check_out, echo_warnings, guard, load_scene, read_scene
 from .plots import DPI, plot_title
 
 # ---------------------------------------------------------------- the table
@@ -189,18 +189,18 @@ def option_name(key):
 @click.option("--param", type=click.Choice(PARAMS), required=True,
               help="Refine in space (h: one uniform refinement per level), in time "
                    "(k: the step halved per level) or both (hk).")
-@click.option("--levels", type=click.IntRange(min=2), default=5, show_default=True,
-              help="Number of levels (>= 2; a meaningful rate needs >= 4).")
+@click.option("--levels", type=click.IntRange(min=2, max=20), default=5, show_default=True,
+              help="Number of levels (2..20; a meaningful rate needs >= 4).")
 @click.option("--reference", type=click.Choice(("exact", "fine")), default=None,
               help="Measure against the scene's [exact] solution, or a fine reference "
                    "run. Default: exact if the scene has an [exact] table, else fine.")
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True,
               help="Run the levels in this many processes (the reference runs first, "
                    "alone).")
-@click.option("--ref-h", type=click.IntRange(min=0), default=None,
+@click.option("--ref-h", type=click.IntRange(min=0, max=12), default=None,
               help="Extra mesh refinements of the fine reference beyond the finest level. "
                    "Default: 2 for --param h/hk, else 0.")
-@click.option("--ref-k", type=click.IntRange(min=0), default=None,
+@click.option("--ref-k", type=click.IntRange(min=0, max=30), default=None,
               help="The fine reference takes 2**REF_K times the steps of the finest level. "
                    "Default: 4 for --param k, 2 for hk, else 0.")
 @click.option("--refine", "base_refine", type=click.IntRange(min=0, max=12), default=None,
@@ -211,8 +211,11 @@ def option_name(key):
                    "for an h-study, so that the time error stays below the space error).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-converge-<param>.")
+@click.option("--force", is_flag=True,
+              help="Run even when the largest run's estimated memory or time exceeds what "
+                   "the machine has.")
 def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, base_steps,
-             out):
+             out, force):
     """Convergence study of SCENE (a TOML file) in h, k or both (MODEL.md §7).
 
     Prints a table of the errors ‖ε(u − u_h)‖, ‖β − β_h‖ and E (max over the
@@ -227,8 +230,9 @@ def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, b
     more --levels too) is refused in that folder: use another --out.
     """
     name, text = read_scene(scene)
-    _, problem = load_scene(text)
+    _, problem = load_scene(text, force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-converge-{param}"
+    check_out(out)
     try:
         study = ConvergenceStudy(text, param, levels, reference, folder=out, ref_h=ref_h,
                                  ref_k=ref_k, refine=base_refine, steps=base_steps,
@@ -241,6 +245,8 @@ def converge(scene, param, levels, reference, jobs, ref_h, ref_k, base_refine, b
         raise CliError(f"--out: {err.message}", 2) from None
     except StudyError as err:
         raise CliError(f"{option_name(err.key)}: {err.message}", 2) from None
+    guard(study.reference_scene or level_scene(study.scene, param, levels - 1), force,
+          what="the largest run of the study")
     echo_warnings(problem)
     if levels < MEANINGFUL_LEVELS:
         click.echo(f"note: --levels {levels}: a least-squares rate is meaningful only over "

@@ -14,7 +14,7 @@ import click
 import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 import numpy as np
 
-from adhesive_contact import SceneError
+from adhesive_contact import SceneError, scene_from_dict
 from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     StudyError,
@@ -23,9 +23,10 @@ from adhesive_contact.studies import (
     Sweep,
     parse_assignment,
 )
-from adhesive_contact.studies.sweep import show
+from adhesive_contact.studies.study import scene_source
+from adhesive_contact.studies.sweep import show, variant_document, variants
 
-from .common import CliError, load_scene, read_scene
+from .common import CliError, check_out, guard, load_scene, read_scene
 from .plots import DPI, plot_title
 
 #: the panels of each figure: (runs.csv column, axis label)
@@ -112,6 +113,21 @@ def table(rows, keys):
     return lines
 
 
+def guard_variants(text, settings, grid, force):
+    """Refuse (exit 2) a sweep with a variant larger than the machine, before
+    any variant's mesh is built (:func:`~.common.guard`)."""
+    if force:
+        return
+    source = scene_source(text)
+    for values in variants(settings, "grid" if grid else "zip"):
+        try:
+            scene = scene_from_dict(variant_document(source, values))
+        except (SceneError, ValueError):
+            continue   # the sweep names the setting at fault
+        where = ", ".join(f"{k}={show(v)}" for k, v in values.items())
+        guard(scene, what=f"the variant {where}")
+
+
 @click.command()
 @click.argument("scene", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--set", "assignments", multiple=True, required=True, metavar="KEY=V1,V2,...",
@@ -126,7 +142,10 @@ def table(rows, keys):
               help="Run the variants in this many processes.")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-sweep.")
-def sweep(scene, assignments, grid, jobs, out):
+@click.option("--force", is_flag=True,
+              help="Run even when a variant's estimated memory or time exceeds what the "
+                   "machine has.")
+def sweep(scene, assignments, grid, jobs, out, force):
     """Run SCENE (a TOML file) for every variant given by --set.
 
     Every variant's scene is checked before anything runs. Writes runs.csv
@@ -140,10 +159,12 @@ def sweep(scene, assignments, grid, jobs, out):
     missing; another sweep is refused in that folder.
     """
     name, text = read_scene(scene)
-    load_scene(text)
+    load_scene(text, force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-sweep"
+    check_out(out)
     try:
         settings = [parse_assignment(a) for a in assignments]
+        guard_variants(text, settings, grid, force)
         study = Sweep(text, settings, "grid" if grid else "zip", folder=out)
         study.open()
     except StudyMismatch as err:
