@@ -28,18 +28,10 @@ import numpy as np
 
 from .contact_boundary import facet_normals, facet_points, tangent_frame
 from .expressions import coordinates
+from .manufactured import TOLERANCE, on_wall
 from .scene import SceneError
 
 #: relative tolerance of the checks, and of the contact and stick sets
-TOLERANCE = 1e-10
-
-
-def on_wall(r, g):
-    """u*_ν = g up to ``TOLERANCE`` · (|u*_ν| + |g|): the contact set (also
-    where :mod:`~adhesive_contact.manufactured` adds λ* to the load)."""
-    return np.abs(r - g) <= TOLERANCE * (np.abs(r) + np.abs(g))
-
-
 def _where(x, i, t):
     return "(" + ", ".join(f"{c:.4g}" for c in x[:, i]) + f"), t = {t:g}"
 

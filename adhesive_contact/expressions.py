@@ -17,7 +17,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-__all__ = ['ExpressionError', 'Expression', 'compile_expression', 'coordinates']
+__all__ = ['ExpressionError', 'Expression', 'chain', 'compile_expression', 'coordinates']
 
 MAX_LENGTH = 2000
 MAX_DEPTH = 100
@@ -92,6 +92,21 @@ def _opname(op):
     return type(op).__name__
 
 
+def chain(node):
+    """A left-nested chain of binary operations ``((a op1 b) op2 c) ...`` as
+    ``(a, [(op1, b), (op2, c), ...])``, found without recursion.
+
+    A flat sum of many terms parses into such a chain, as deep as it is
+    long; checking and evaluating it link by link keeps its depth one level
+    (and Python's recursion short), while the result is the same, operation
+    for operation, as the nested form's."""
+    links = []
+    while isinstance(node, ast.BinOp):
+        links.append((node.op, node.right))
+        node = node.left
+    return node, links[::-1]
+
+
 def _check(node, uses, depth=0):
     """Validate ``node`` recursively and collect the variables it uses."""
     if depth > MAX_DEPTH:
@@ -122,10 +137,13 @@ def _check(node, uses, depth=0):
                                   .format(node.id, ALLOWED_NAMES))
         return
     if isinstance(node, ast.BinOp):
-        if type(node.op) not in BINOPS:
-            raise ExpressionError("operator {} is not allowed; use + - * / **"
-                                  .format(_opname(node.op)))
-        children = [node.left, node.right]
+        # a chain a + b - c ... is one level, however long (see chain())
+        base, links = chain(node)
+        for op, _ in links:
+            if type(op) not in BINOPS:
+                raise ExpressionError("operator {} is not allowed; use + - * / **"
+                                      .format(_opname(op)))
+        children = [base] + [right for _, right in links]
     elif isinstance(node, ast.UnaryOp):
         if type(node.op) not in UNARYOPS:
             raise ExpressionError("operator {} is not allowed; use unary + -"
@@ -173,8 +191,11 @@ def _eval(node, env):
     if isinstance(node, ast.Name):
         return env[node.id]
     if isinstance(node, ast.BinOp):
-        return BINOPS[type(node.op)](_float(_eval(node.left, env)),
-                                     _float(_eval(node.right, env)))
+        base, links = chain(node)
+        value = _float(_eval(base, env))
+        for op, right in links:
+            value = BINOPS[type(op)](value, _float(_eval(right, env)))
+        return value
     if isinstance(node, ast.UnaryOp):
         return UNARYOPS[type(node.op)](_float(_eval(node.operand, env)))
     if isinstance(node, ast.Compare):
@@ -184,7 +205,9 @@ def _eval(node, env):
             out = np.logical_and(out, COMPAREOPS[type(op)](left, right))
             left = right
         return out
-    return FUNCTIONS[node.func.id].numpy(*(_eval(arg, env) for arg in node.args))
+    # arguments as float64: a comparison's booleans would make NumPy
+    # compute in float16 (exp(x > 1) = 2.71875)
+    return FUNCTIONS[node.func.id].numpy(*(_float(_eval(arg, env)) for arg in node.args))
 
 
 class Expression:

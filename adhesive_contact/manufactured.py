@@ -1,4 +1,4 @@
-"""Manufactured solutions: the data an exact solution implies (MODEL.md §7).
+"""Manufactured solutions: the data an exact solution implies (docs/verification.md).
 
 A scene's ``[exact]`` table gives u*(x, t), β*(x, t) and, where u*_ν = g,
 a wall multiplier λ*(x, t) > 0. This module derives, with sympy for the
@@ -25,8 +25,16 @@ from functools import partial
 
 import numpy as np
 
-from .admissibility import on_wall
-from .expressions import FUNCTIONS
+from .expressions import FUNCTIONS, VARIABLES, Expression, chain
+
+#: relative tolerance of "u*_ν = g" (the contact set of a manufactured solution)
+TOLERANCE = 1e-10
+
+
+def on_wall(r, g):
+    """u*_ν = g up to ``TOLERANCE`` · (|u*_ν| + |g|): the contact set, where
+    the load gets λ* (and :mod:`~adhesive_contact.admissibility` checks λ* ≥ 0)."""
+    return np.abs(r - g) <= TOLERANCE * (np.abs(r) + np.abs(g))
 
 _GAUSS_POINTS = 16   # Gauss–Legendre points in s for the memory integral (exact to
                      # round-off for the smooth integrands of manufactured data)
@@ -35,6 +43,41 @@ _GAUSS_POINTS = 16   # Gauss–Legendre points in s for the memory integral (exa
 def _sympy():
     import sympy
     return sympy
+
+
+#: the largest constant exponent |p| of x**p that sympy is given: with exact
+#: integers, 9**9**9 or x**1e308 would make it work without end
+MAX_EXPONENT = 64
+
+
+def _variable_free(node):
+    return not any(isinstance(n, ast.Name) and n.id in VARIABLES for n in ast.walk(node))
+
+
+def _constant(node):
+    """The float value of a variable-free subtree."""
+    return float(Expression("", node, ())(0.0))
+
+
+def symbolic_problem(expression):
+    """Why sympy must not be given ``expression`` (an Expression), or None.
+
+    Refused: a constant part that is not finite (``1/0``, ``1e308*10``), and
+    a power with a constant exponent beyond ±MAX_EXPONENT. Checked on
+    floats, before sympy sees anything, so the check itself is fast."""
+    for node in ast.walk(expression._tree):
+        if not isinstance(node, ast.expr) or isinstance(node, (ast.Constant, ast.Name)) \
+                or not _variable_free(node):
+            pass
+        elif not np.isfinite(_constant(node)):
+            return f"a constant part is not finite ({_constant(node):g})"
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow) \
+                and _variable_free(node.right):
+            p = _constant(node.right)
+            if not abs(p) <= MAX_EXPONENT:
+                return (f"the exponent {p:g} is too large for the symbolic derivation "
+                        f"(at most {MAX_EXPONENT} in absolute value)")
+    return None
 
 
 def to_sympy(expression, symbols):
@@ -54,7 +97,11 @@ def to_sympy(expression, symbols):
         if isinstance(node, ast.Name):
             return names[node.id]
         if isinstance(node, ast.BinOp):
-            return binops[type(node.op)](walk(node.left), walk(node.right))
+            base, links = chain(node)
+            value = walk(base)
+            for op, right in links:
+                value = binops[type(op)](value, walk(right))
+            return value
         if isinstance(node, ast.UnaryOp):
             value = walk(node.operand)
             return -value if isinstance(node.op, ast.USub) else value

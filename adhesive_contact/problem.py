@@ -32,6 +32,7 @@ from .memory import make_memory
 from .meshes import build_mesh, named_facets
 from .scene import SceneError
 from .smallness import smallness
+from .value_checks import check_exact, check_kernel, check_loads
 
 
 @dataclass(kw_only=True)
@@ -70,7 +71,7 @@ class Problem:
 
     @property
     def smallness(self):
-        """The terms of MODEL.md §2's condition (None without contact),
+        """The terms of docs/model.md §3's condition (None without contact),
         computed on first use (a generalised eigenproblem) and kept."""
         if self._smallness is None and self.boundary is not None:
             self._smallness = smallness(self.scene, self.normal_law, self.friction)
@@ -85,7 +86,7 @@ class Problem:
                     "step has one solution" if s["step_energy_convex"] else
                     "the step energy may be nonconvex: the solver may fail or pick one of "
                     "several solutions")
-            out.append(f"smallness condition of MODEL.md §2 does not hold: m_A = "
+            out.append(f"smallness condition of docs/model.md §3 does not hold: m_A = "
                        f"{s['m_A']:.4g} <= (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}; uniqueness "
                        f"is not guaranteed by the theory; {tail}")
         if (self.bonding is not None and self.scene.contact.integrator == "explicit"
@@ -140,6 +141,8 @@ def build_problem(scene):
     position[free] = np.arange(free.size)
 
     times = scene.k * np.arange(scene.steps + 1)
+    if scene.memory is not None and scene.memory.kernel == "function":
+        check_kernel("memory.r", scene.memory.function, scene.k, scene.steps)
     friction = make_friction(scene.contact.friction)
     boundary, gap, beta0 = None, None, np.zeros(0)
     columns = contact_positions = np.zeros(0, dtype=np.int64)
@@ -185,8 +188,17 @@ def build_problem(scene):
         body = None if is_zero(scene.body) else vector_of(scene.body)
         surface = [(named_facets(mesh, [side], "loads.traction", indexed=False), vector_of(exprs))
                    for side, exprs in scene.traction.items()]
+        checks = ([] if body is None else
+                  [[(f"loads.body[{i}]", e) for i, e in enumerate(scene.body)]])
+        checks += [[(f"loads.traction.{side}[{i}]", e) for i, e in enumerate(exprs)]
+                   for side, exprs in scene.traction.items()]
     else:
-        exact = ManufacturedSolution(scene, normal_law, friction, bonding)
+        check_exact(scene.exact, mesh.p, times)
+        try:
+            exact = ManufacturedSolution(scene, normal_law, friction, bonding)
+        except (ArithmeticError, ValueError, TypeError, KeyError) as err:
+            raise SceneError("exact", "the loads cannot be derived from the exact solution "
+                             f"({type(err).__name__}: {err})") from None
         check_manufactured(scene, mesh, exact, times, scene.contact.gap, dirichlet_facets,
                            contact_facets)
         body = exact.body_force
@@ -205,6 +217,9 @@ def build_problem(scene):
             beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
             beta0 = _facet_mean(mesh, boundary, exact.beta)
     loads = LoadMap(mesh, body, surface)
+    if scene.exact is not None:
+        checks = [[("exact", field)] for field, _, _ in loads.parts]
+    check_loads(checks, loads, times)
     return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free,
                    prescribed=prescribed, boundary=boundary,
                    columns=columns, contact_positions=contact_positions, loads=loads, gap=gap,

@@ -1,4 +1,4 @@
-"""Scenes: the validated description of one problem (SPEC.md, scene file).
+"""Scenes: the validated description of one problem (docs/scenes.md).
 
 A scene is read from a file (``load_scene(path)``), a TOML document
 (``parse_scene(text, base_dir)``) or the dictionary it decodes to
@@ -29,6 +29,7 @@ from .bonding import INTEGRATORS
 from .expressions import ExpressionError, compile_expression
 from .laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
 from .linear_solvers import METHODS
+from .manufactured import symbolic_problem
 from .linear_solvers.pardiso import available as pardiso_available
 from .step_methods import METHODS as STEP_METHODS
 
@@ -40,6 +41,15 @@ class SceneError(ValueError):
         self.key = key
         super().__init__(f"{key}: {message}" if key else message)
 
+
+#: the ranges every scene must keep (see the readers that use them for why)
+MAX_TITLE = 500             # characters of the title (it heads every plot)
+LENGTHS = (1e-6, 1e6)       # each length of the domain; rescale the units outside
+MAX_CELL_ASPECT = 1e3       # longest over shortest edge of the structured cells
+MAX_NODES = 10**8           # nodes of the refined mesh
+MAX_STEPS = 10**8           # time steps
+TOL_RANGE = (1e-14, 1e-3)   # solver.tol, relative to the force scale of a step
+MAX_ITER = 10_000           # solver.max_iter
 
 SIDES = {2: ("left", "right", "bottom", "top"),
          3: ("left", "right", "bottom", "top", "front", "back")}
@@ -177,7 +187,7 @@ class ContactSpec:
 
 @dataclass(frozen=True)
 class ExactSpec:
-    """A manufactured solution (MODEL.md §7): u*, β* and the wall multiplier λ*."""
+    """A manufactured solution (docs/verification.md): u*, β* and the wall multiplier λ*."""
 
     u: tuple                      # d Expressions in x, y, (z), t
     beta: object = None           # Expression, or None (β* = 1)
@@ -509,6 +519,7 @@ def _read_mesh(table, dim, base_dir):
                                    and s > 0 for s in size):
         raise SceneError(table.key("size"), f"must be a list of {dim} positive lengths, "
                          f"got {_show(size)}")
+    _lengths(table.key("size"), size)
     cells = table.get("cells", "list")
     if len(cells) != dim or not all(isinstance(c, int) and not isinstance(c, bool)
                                     and c >= 1 for c in cells):
@@ -516,9 +527,47 @@ def _read_mesh(table, dim, base_dir):
                          f"got {_show(cells)}")
     patterns = ("diagonal", "cross") if dim == 2 else ("diagonal",)
     pattern = _choice(table.key("pattern"), table.get("pattern", "str", "diagonal"), patterns)
+    _cell_counts(table.key("cells"), size, cells, refine, pattern)
     table.finish()
     return MeshSpec(domain, tuple(float(s) for s in size), tuple(cells), pattern, refine,
                     dim=dim)
+
+
+def _lengths(key, size):
+    """Each length finite and within LENGTHS: outside, the element volumes
+    (h^d, refined up to 4096 times) underflow or the stiffness overflows,
+    and the factorisation meets zero pivots."""
+    lo, hi = LENGTHS
+    for i, s in enumerate(size):
+        if not lo <= s <= hi:   # False for inf and nan
+            raise SceneError(f"{key}[{i}]", f"must be a finite length in [{lo:g}, {hi:g}] "
+                             f"(rescale the units), got {s!r}")
+
+
+def nodes_of(size_cells, refine, pattern="diagonal"):
+    """The number of nodes of the structured mesh of ``cells`` refined
+    ``refine`` times (exact, in Python integers: no overflow)."""
+    n = [c * 2**refine for c in size_cells]
+    nodes = math.prod(c + 1 for c in n)
+    if pattern == "cross":   # a centre node per quadrilateral of the unrefined mesh,
+        nodes += math.prod(size_cells) * 4**refine   # refined with the rest
+    return nodes
+
+
+def _cell_counts(key, size, cells, refine, pattern):
+    """At most MAX_NODES nodes after refinement (numpy cannot index more
+    anyway, and the memory check needs a count it can estimate from), and
+    cells no more elongated than MAX_CELL_ASPECT (their stiffness would be
+    nearly singular)."""
+    nodes = nodes_of(cells, refine, pattern)
+    if nodes > MAX_NODES:
+        raise SceneError(key, f"gives {nodes:.3g} nodes after {refine} refinements; at most "
+                         f"{MAX_NODES:.0e} are allowed")
+    edges = [s / c for s, c in zip(size, cells)]
+    if max(edges) > MAX_CELL_ASPECT * min(edges):
+        raise SceneError(key, f"cells of {' x '.join(f'{e:.3g}' for e in edges)} are "
+                         f"elongated more than {MAX_CELL_ASPECT:g}:1; choose cells "
+                         "closer to the proportions of mesh.size")
 
 
 def _read_mesh_file(table, dim, base_dir, refine):
@@ -816,10 +865,23 @@ def _read_time(table):
     """(T, steps)."""
     T = _positive("time.T", table.get("T", "number"))
     steps = table.get("steps", "int")
-    if steps < 1:
-        raise SceneError("time.steps", f"must be an integer >= 1, got {steps}")
+    if not 1 <= steps <= MAX_STEPS:
+        raise SceneError("time.steps", f"must be an integer in 1..{MAX_STEPS:.0e}, got {steps}")
     table.finish()
     return T, steps
+
+
+def _tolerance(key, tol):
+    """tol within TOL_RANGE: the residual is relative to the step's force
+    scale, so a tol near 1 accepts the starting point as the solution (no
+    Newton iteration, a quiet wrong answer), and below 1e-14 round-off
+    keeps the residual from reaching it."""
+    lo, hi = TOL_RANGE
+    if not lo <= tol <= hi:
+        raise SceneError(key, f"must lie in [{lo:g}, {hi:g}], got {tol:g}: it is relative to "
+                         "the force scale of a step, so a larger tol accepts the start as the "
+                         "solution and a smaller one is below round-off")
+    return tol
 
 
 def _read_solver(table):
@@ -827,10 +889,11 @@ def _read_solver(table):
     if table is None:
         return SolverSpec()
     method = _choice("solver.method", table.get("method", "str", "newton"), tuple(STEP_METHODS))
-    tol = _positive("solver.tol", table.get("tol", "number", 1e-10))
+    tol = _tolerance("solver.tol", table.get("tol", "number", 1e-10))
     max_iter = table.get("max_iter", "int", 50)
-    if max_iter < 1:
-        raise SceneError("solver.max_iter", f"must be an integer >= 1, got {max_iter}")
+    if not 1 <= max_iter <= MAX_ITER:
+        raise SceneError("solver.max_iter", f"must be an integer in 1..{MAX_ITER}, "
+                         f"got {max_iter}")
     linear = _choice("solver.linear", table.get("linear", "str", "auto"), METHODS)
     if linear == "pardiso" and not pardiso_available():
         raise SceneError("solver.linear", "'pardiso' needs pypardiso and MKL, which are not "
@@ -881,7 +944,17 @@ def _read_exact(table, dim, contact, has_loads):
     if contact.beta0 is not None:
         raise SceneError("contact.bonding.beta0", "a scene with [exact] takes β_0 from "
                          "exact.beta; remove beta0")
+    _symbolic(("exact.u[0]", "exact.u[1]", "exact.u[2]")[:dim] + ("exact.beta",
+              "exact.multiplier"), u + (beta, multiplier))
     return ExactSpec(u, beta, multiplier)
+
+
+def _symbolic(keys, expressions):
+    """Expressions sympy can differentiate without overflowing or hanging."""
+    for key, expression in zip(keys, expressions):
+        problem = None if expression is None else symbolic_problem(expression)
+        if problem:
+            raise SceneError(key, f"{problem} (in {_show(expression.source)})")
 
 
 def _coordinates(dim):
@@ -894,6 +967,8 @@ def scene_from_dict(data, base_dir=None):
     (default: the working directory)."""
     top = _Table(data, "")
     title = top.get("title", "str", "untitled", required=False)
+    if len(title) > MAX_TITLE:
+        raise SceneError("title", f"must have at most {MAX_TITLE} characters, got {len(title)}")
     dim = top.get("dim", "int")
     if dim not in (2, 3):
         raise SceneError("dim", f"must be 2 (plane strain) or 3, got {dim}")
@@ -930,6 +1005,9 @@ def parse_scene(text, base_dir=None):
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SceneError("", f"not valid TOML: {err}") from None
+    except RecursionError:
+        raise SceneError("", "not a usable TOML document: arrays or tables nested too "
+                         "deeply") from None
     return scene_from_dict(data, base_dir)
 
 

@@ -1,10 +1,13 @@
 """What the ``adhcontact`` commands share: one-line errors, reading a scene
-file, parsing and validating it, and reporting the problem's warnings.
+file, parsing and validating it, refusing a run larger than the machine
+(:func:`guard`), checking the output folder, and reporting the problem's
+warnings.
 
 Every command parses and validates its scene with these before it creates
 any output, so a bad scene exits 2 with one line and writes nothing.
 """
 
+import os
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -12,6 +15,7 @@ from pathlib import Path
 import click
 
 from adhesive_contact import SceneError, build_problem, parse_scene
+from adhesive_contact.resources import estimate, free_disk, refusal
 
 DEFAULT_SCENE = "default_scene.toml"
 
@@ -47,12 +51,15 @@ def scene_folder(path):
     return None if path is None else Path(path).parent
 
 
-def load_scene(text, base_dir=None):
+def load_scene(text, base_dir=None, force=False, out=None):
     """(scene, problem) of a TOML scene text whose relative paths are taken
     in ``base_dir`` (:func:`scene_folder`), as the library's
-    ``load_scene(path)`` does; a bad scene is a :class:`CliError` (exit 2)."""
+    ``load_scene(path)`` does; a bad scene is a :class:`CliError` (exit 2),
+    and so is one larger than the machine unless ``force`` (:func:`guard`,
+    before the mesh is built)."""
     try:
         scene = parse_scene(text, base_dir)
+        guard(scene, force, out)
         return scene, build_problem(scene)
     except SceneError as err:
         raise CliError(str(err), 2) from None
@@ -69,6 +76,38 @@ def study_source(text, base_dir=None):
         if not path.is_absolute():
             mesh["file"] = str((Path(base_dir) / path).resolve())
     return document
+
+
+#: the keys a run's size comes from, named when it is refused
+SIZE_KEYS = "mesh.cells, mesh.refine, time.steps, boundary.contact"
+
+
+def guard(scene, force=False, out=None, what="the scene"):
+    """Refuse (exit 2) a run whose estimated memory, time or output
+    (:mod:`adhesive_contact.resources`) exceeds what the machine has,
+    unless ``force``; ``out`` is where the outputs go (its free disk is
+    checked), None not to check the disk."""
+    if force:
+        return
+    est = estimate(scene)
+    reason = refusal(est, disk=None if out is None else free_disk(out))
+    if reason:
+        raise CliError(f"{SIZE_KEYS}: {what} is too large for this machine: {reason} "
+                       f"(estimate: {est.describe()}); use a smaller scene, or --force "
+                       "to run it anyway", 2)
+
+
+def check_out(out):
+    """Refuse (exit 2) an ``--out`` that cannot take the outputs, before the solve.
+
+    An existing folder is fine: only the run's own files are replaced in it
+    (:func:`~.output.write_outputs`), a user's other files stay."""
+    if out.exists() and not out.is_dir():
+        raise CliError(f"--out: {str(out)!r} exists and is not a folder", 2)
+    existing = next(p for p in [out.absolute(), *out.absolute().parents] if p.exists())
+    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
+        raise CliError(f"--out: {str(out)!r} cannot be written ({str(existing)!r} is not "
+                       "a writable folder)", 2)
 
 
 def echo_warnings(problem):

@@ -1,5 +1,5 @@
-"""``adhcontact converge``: a convergence study in h, k or both (SPEC.md,
-"Command line (firm)"; MODEL.md §7).
+"""``adhcontact converge``: a convergence study in h, k or both (docs/scenes.md,
+"Command line (firm)"; docs/verification.md).
 
 The study is :class:`adhesive_contact.studies.ConvergenceStudy` (what to
 (re)compute, the folder ``--out`` that keeps it, errors.csv and
@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 import numpy as np
 from matplotlib.ticker import NullFormatter  # noqa: E402
 
-from adhesive_contact.convergence import PARAMS
+from adhesive_contact.convergence import PARAMS, level_scene
 from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     ConvergenceStudy,
@@ -32,13 +32,15 @@ from adhesive_contact.studies.executors import ClusterError
 
 from .common import (
     CliError,
+    check_out,
     echo_warnings,
+    guard,
     load_scene,
     read_scene,
     scene_folder,
     study_source,
 )
-from .plots import DPI
+from .plots import DPI, plot_title
 from .scheduler import open_executor, scheduler_option
 
 # ---------------------------------------------------------------- the table
@@ -91,7 +93,7 @@ def _reference_phrase(info):
 
 
 def _suptitle(fig, document, title):
-    wrapped = textwrap.fill(title, 70)
+    wrapped = textwrap.fill(plot_title(title), 70)
     fig.suptitle(f"{wrapped}\n{document['param']}-refinement, {len(document['levels'])} "
                  f"levels; {_reference_phrase(document['reference'])}", fontsize="medium")
 
@@ -198,8 +200,8 @@ def option_name(key):
 @click.option("--param", type=click.Choice(PARAMS), required=True,
               help="Refine in space (h: one uniform refinement per level), in time "
                    "(k: the step halved per level) or both (hk).")
-@click.option("--levels", type=click.IntRange(min=2), default=5, show_default=True,
-              help="Number of levels (>= 2; a meaningful rate needs >= 4).")
+@click.option("--levels", type=click.IntRange(min=2, max=20), default=5, show_default=True,
+              help="Number of levels (2..20; a meaningful rate needs >= 4).")
 @click.option("--reference", type=click.Choice(("exact", "fine")), default=None,
               help="Measure against the scene's [exact] solution, or a fine reference "
                    "run. Default: exact if the scene has an [exact] table, else fine.")
@@ -207,10 +209,10 @@ def option_name(key):
               help="Run the levels in this many local processes (the reference runs "
                    "first, alone, here).  [default: 1]")
 @scheduler_option("levels (the fine reference runs first, here)")
-@click.option("--ref-h", type=click.IntRange(min=0), default=None,
+@click.option("--ref-h", type=click.IntRange(min=0, max=12), default=None,
               help="Extra mesh refinements of the fine reference beyond the finest level. "
                    "Default: 2 for --param h/hk, else 0.")
-@click.option("--ref-k", type=click.IntRange(min=0), default=None,
+@click.option("--ref-k", type=click.IntRange(min=0, max=30), default=None,
               help="The fine reference takes 2**REF_K times the steps of the finest level. "
                    "Default: 4 for --param k, 2 for hk, else 0.")
 @click.option("--refine", "base_refine", type=click.IntRange(min=0, max=12), default=None,
@@ -221,9 +223,12 @@ def option_name(key):
                    "for an h-study, so that the time error stays below the space error).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-converge-<param>.")
+@click.option("--force", is_flag=True,
+              help="Run even when the largest run's estimated memory or time exceeds what "
+                   "the machine has.")
 def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, base_refine,
-             base_steps, out):
-    """Convergence study of SCENE (a TOML file) in h, k or both (MODEL.md §7).
+             base_steps, out, force):
+    """Convergence study of SCENE (a TOML file) in h, k or both (docs/verification.md).
 
     Prints a table of the errors ‖ε(u − u_h)‖, ‖β − β_h‖ and E (max over the
     time grid) per level with their least-squares rates, and writes
@@ -237,10 +242,12 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     more --levels too) is refused in that folder: use another --out.
     """
     name, text = read_scene(scene)
-    _, problem = load_scene(text, scene_folder(scene))
+    _, problem = load_scene(text, scene_folder(scene), force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-converge-{param}"
+    check_out(out)
     try:
-        study = ConvergenceStudy(study_source(text, scene_folder(scene)), param, levels, reference, folder=out, ref_h=ref_h,
+        study = ConvergenceStudy(study_source(text, scene_folder(scene)), param, levels,
+                                 reference, folder=out, ref_h=ref_h,
                                  ref_k=ref_k, refine=base_refine, steps=base_steps,
                                  scene_file=str(scene))
         study.open()
@@ -251,11 +258,13 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
         raise CliError(f"--out: {err.message}", 2) from None
     except StudyError as err:
         raise CliError(f"{option_name(err.key)}: {err.message}", 2) from None
+    guard(study.reference_scene or level_scene(study.scene, param, levels - 1), force,
+          what="the largest run of the study")
     executor = open_executor(scheduler, jobs)
     echo_warnings(problem)
     if levels < MEANINGFUL_LEVELS:
         click.echo(f"note: --levels {levels}: a least-squares rate is meaningful only over "
-                   f">= {MEANINGFUL_LEVELS} levels (MODEL.md §7)", err=True)
+                   f">= {MEANINGFUL_LEVELS} levels (docs/verification.md)", err=True)
 
     bars = Progress(name, study)
     try:

@@ -1,4 +1,4 @@
-"""``adhcontact``: the click front end (SPEC.md, "Command line (firm)").
+"""``adhcontact``: the click front end (docs/outputs.md).
 
 Exit codes: 0 success; 2 a bad scene or bad arguments (nothing written);
 1 a run that failed (a step that did not converge or gave an invalid
@@ -13,7 +13,6 @@ line ``warning: ...`` each on stderr before the time loop, and the run
 goes on."""
 
 import contextlib
-import os
 import signal
 import sys
 import threading
@@ -27,7 +26,7 @@ from adhesive_contact.postprocess import beta_mean
 from adhesive_contact.sanity import magnitude_warnings
 from adhesive_contact.scheme import STOPPED
 
-from .common import CliError, echo_warnings, load_scene, read_scene, scene_folder
+from .common import CliError, check_out, echo_warnings, load_scene, read_scene, scene_folder
 from .converge import converge
 from .output import staged_output, write_results
 from .sweep import sweep
@@ -56,20 +55,12 @@ class OneLineGroup(click.Group):
         except click.Abort:
             click.echo("error: aborted", err=True)
             sys.exit(1)
+        except MemoryError:
+            click.echo("error: out of memory (the run needed more than the machine had; "
+                       "the size check was skipped with --force or underestimated it)",
+                       err=True)
+            sys.exit(1)
         sys.exit(code if isinstance(code, int) else 0)
-
-
-def check_out(out):
-    """Refuse (exit 2) an ``--out`` that cannot take the outputs, before the solve.
-
-    An existing folder is fine: only the run's own files are replaced in it
-    (:func:`~.output.staged_output`), a user's other files stay."""
-    if out.exists() and not out.is_dir():
-        raise CliError(f"--out: {str(out)!r} exists and is not a folder", 2)
-    existing = next(p for p in [out.absolute(), *out.absolute().parents] if p.exists())
-    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
-        raise CliError(f"--out: {str(out)!r} cannot be written ({str(existing)!r} is not "
-                       "a writable folder)", 2)
 
 
 @contextlib.contextmanager
@@ -106,19 +97,22 @@ def main():
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder; in an existing one only the run's own files are replaced. "
                    "Default: ./<scene file stem>, ./default for the built-in scene.")
-def solve_command(scene, out):
+@click.option("--force", is_flag=True,
+              help="Run even when the estimated memory, time or output size exceeds what "
+                   "the machine has (summary.json records the estimate).")
+def solve_command(scene, out, force):
     """Run SCENE (a TOML file; the built-in default scene if omitted).
 
     Writes summary.json, solution.npz, solution.xdmf/.h5 (ParaView) and PNG
     plots into the output folder.
     """
     name, text = read_scene(scene)
-    parsed, problem = load_scene(text, scene_folder(scene))
     out = Path(out) if out is not None else Path.cwd() / name
+    parsed, problem = load_scene(text, scene_folder(scene), force, out)
     check_out(out)
     echo_warnings(problem)
 
-    files = []
+    files, failures = [], []
     try:
         with staged_output(out) as folder:
             recorder = StreamingRecorder(problem, folder)   # levels to disk as computed
@@ -131,12 +125,14 @@ def solve_command(scene, out):
                 if solution.t.size:   # the levels that converged, partial or not
                     for warning in magnitude_warnings(solution):
                         click.echo(f"warning: {warning}", err=True)
-                    files = write_results(solution, folder)
+                    files = write_results(solution, folder, failures)
             finally:
                 recorder.close()
             files = sorted(files + recorder.names) if files else []
     except OSError as err:
         raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+    for failure in failures:
+        click.echo(f"warning: {failure}", err=True)
     if solution.status == STOPPED:
         raise CliError(f"interrupted after step {solution.steps} (t = {solution.t[-1]:g}); "
                        f"the {solution.t.size} levels done were written to {out}/ "

@@ -1,4 +1,4 @@
-"""The output folder of ``adhcontact solve`` (SPEC.md, "Command line").
+"""The output folder of ``adhcontact solve`` (docs/outputs.md).
 
 :func:`staged_output` gives a temporary folder that the run writes into
 and then moves into place (:func:`_publish`), so a reader never sees a
@@ -9,7 +9,8 @@ adds the rest:
 
 - ``summary.json``: resolved scene, mesh counts, how the run ended, the
   smallness terms (null without contact), the warnings of the problem,
-  timings, the linear backend, iterations and one record per time level
+  timings, the linear backend, the estimated resources beside those used
+  (``resources``), iterations and one record per time level
   (:func:`~.postprocess.step_records`);
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
 - ``solution.xdmf`` + ``solution.h5`` and ``contact.xdmf`` + ``contact.h5``
@@ -18,12 +19,15 @@ adds the rest:
 """
 
 import contextlib
+import glob
 import os
+import resource
 import shutil
 import tempfile
 from pathlib import Path
 
 from adhesive_contact.io import write_npz, write_xdmf
+from adhesive_contact.resources import estimate
 from adhesive_contact.sanity import magnitude_warnings
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
@@ -50,8 +54,23 @@ def summary(solution):
         "warnings": [str(w) for w in problem.warnings()] + magnitude_warnings(solution),
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
+        "resources": resources_record(solution),
         "iterations": [int(i) for i in solution.iterations],
         "steps": step_records(solution),
+    }
+
+
+def resources_record(solution):
+    """The estimate made from the scene before the run
+    (:func:`adhesive_contact.resources.estimate`) beside what was used."""
+    problem = solution.problem
+    return {
+        "estimate": estimate(problem.scene).record(),
+        "used": {"dofs": int(problem.ndofs), "contact_unknowns": int(problem.columns.size),
+                 "levels": int(solution.t.size), "backend": solution.linear.get("method"),
+                 "seconds": json_number(solution.timings.get("total", float("nan"))),
+                 "peak_memory_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+                 * 1024},
     }
 
 
@@ -107,6 +126,30 @@ def _publish(staging, target):
     staging.rmdir()
 
 
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:       # another user's process: alive
+        return True
+    return True
+
+
+def remove_stale(folder, prefix):
+    """Remove the staging folders ``<prefix><pid>-XXXX`` in ``folder`` left by
+    runs that were killed (their process ``pid`` no longer exists); return
+    their names. A staging folder of a live run, or one named otherwise,
+    stays."""
+    removed = []
+    for path in Path(folder).glob(f"{glob.escape(prefix)}*-*"):
+        pid = path.name[len(prefix):].split("-", 1)[0]
+        if path.is_dir() and pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(path, ignore_errors=True)
+            removed.append(path.name)
+    return removed
+
+
 @contextlib.contextmanager
 def staged_output(out):
     """A temporary folder for the outputs of ``out``, published into ``out``
@@ -117,14 +160,19 @@ def staged_output(out):
     ----------
     out : path of the output folder; its parents are created. In an
         existing folder only the files of :data:`OUTPUT_NAMES` are replaced;
-        a user's other files stay.
+        a user's other files stay. The files are staged in a folder named
+        after this process (``<out>.tmp-<pid>-*`` beside a new ``out``,
+        ``.adhcontact.tmp-<pid>-*`` inside an existing one); those of killed
+        runs are removed first (:func:`remove_stale`).
     """
     out = Path(out).absolute()
     if out.is_dir():   # staged inside, so that os.replace stays on one file system
-        tmp = Path(tempfile.mkdtemp(prefix=".adhcontact.tmp-", dir=out))
+        remove_stale(out, ".adhcontact.tmp-")
+        tmp = Path(tempfile.mkdtemp(prefix=f".adhcontact.tmp-{os.getpid()}-", dir=out))
     else:
         out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-", dir=out.parent))
+        remove_stale(out.parent, f"{out.name}.tmp-")
+        tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-{os.getpid()}-", dir=out.parent))
     try:
         yield tmp
         if (tmp / "summary.json").exists():
@@ -136,18 +184,20 @@ def staged_output(out):
         raise
 
 
-def write_results(solution, folder):
+def write_results(solution, folder, failures=None):
     """Write summary.json, solution.npz and the plots of a solution into
-    ``folder`` (the XDMF series are the recorder's); return their names."""
+    ``folder`` (the XDMF series are the recorder's); return their names. A
+    plot that cannot be drawn is left out and named in ``failures`` (a
+    list), if given; the data files are written all the same."""
     folder = Path(folder)
     write_summary(solution, folder / "summary.json")
     write_npz(solution, folder / "solution.npz")
-    return ["summary.json", "solution.npz"] + plots.write_plots(solution, folder)
+    return ["summary.json", "solution.npz"] + plots.write_plots(solution, folder, failures)
 
 
-def write_outputs(solution, out):
+def write_outputs(solution, out, failures=None):
     """Write all outputs of a finished in-memory solution into ``out``,
     atomically; return the names of the files written."""
     with staged_output(out) as tmp:
-        names = sorted(write_xdmf(solution, tmp) + write_results(solution, tmp))
+        names = sorted(write_xdmf(solution, tmp) + write_results(solution, tmp, failures))
     return names

@@ -89,8 +89,21 @@ def magnification(points, u):
     return max(1.0, float(f"{0.1 * extent / umax:.2g}"))
 
 
+#: the longest title drawn; a longer one is cut with an ellipsis
+TITLE_CHARS = 120
+
+
+def plot_title(title):
+    """A scene title as matplotlib may draw it: ``$`` escaped (it would start
+    mathtext, and "$x^$" cannot be parsed), cut to TITLE_CHARS characters."""
+    title = " ".join(str(title).split())
+    if len(title) > TITLE_CHARS:
+        title = title[:TITLE_CHARS - 1] + "…"
+    return title.replace("$", r"\$")
+
+
 def _title(solution):
-    return solution.problem.scene.title
+    return plot_title(solution.problem.scene.title)
 
 
 def _deformed_2d(fig, ax, solution, factor):
@@ -517,26 +530,36 @@ def plot_load_displacement(solution, path, curves=None):
 PLOT_NAMES = ("deformed", "contact_traction", "beta", "contact_map", "load_displacement")
 
 
-def write_plots(solution, folder):
+def write_plots(solution, folder, failures=None):
     """Draw the figures into ``folder``; return the names of the files written.
 
     The contact figures are skipped (not an error) when the scene has no
     contact boundary; ``contact_map.png`` (colour maps over Γ_C) is drawn
-    in 3D only."""
-    names = ["deformed.png"]
-    plot_deformed(solution, folder / names[0])
+    in 3D only, ``load_displacement.png`` for scenes that move or load a
+    side. A figure that cannot be drawn is left out and, when ``failures``
+    is a list, named there with the reason: the plots must never cost the
+    run's data."""
+    plots = [("deformed.png", plot_deformed)]
     boundary = solution.problem.boundary
     if boundary is not None and boundary.facets.size:
         if boundary.nodes.size:
-            names.append("contact_traction.png")
-            plot_contact_traction(solution, folder / names[-1])
-        names.append("beta.png")
-        plot_beta(solution, folder / names[-1])
+            plots.append(("contact_traction.png", plot_contact_traction))
+        plots.append(("beta.png", plot_beta))
         if solution.problem.dim == 3:
-            names.append("contact_map.png")
-            plot_contact_map(solution, folder / names[-1])
+            plots.append(("contact_map.png", plot_contact_map))
     curves = load_curves(solution)
     if curves:
-        names.append("load_displacement.png")
-        plot_load_displacement(solution, folder / names[-1], curves)
+        plots.append(("load_displacement.png",
+                      lambda solution, path: plot_load_displacement(solution, path, curves)))
+    names = []
+    for name, plot in plots:
+        try:
+            plot(solution, folder / name)
+            names.append(name)
+        except Exception as err:   # noqa: BLE001  (any drawing failure: the data stays)
+            plt.close("all")
+            (folder / name).unlink(missing_ok=True)
+            if failures is not None:
+                failures.append(f"{name} was not drawn: {type(err).__name__}: "
+                                f"{' '.join(str(err).split())[:200]}")
     return names

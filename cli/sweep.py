@@ -14,7 +14,7 @@ import click
 import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 import numpy as np
 
-from adhesive_contact import SceneError
+from adhesive_contact import SceneError, scene_from_dict
 from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     StudyError,
@@ -24,10 +24,10 @@ from adhesive_contact.studies import (
     parse_assignment,
 )
 from adhesive_contact.studies.executors import ClusterError
-from adhesive_contact.studies.sweep import LOST, show
+from adhesive_contact.studies.sweep import LOST, show, variant_document, variants
 
-from .common import CliError, load_scene, read_scene, scene_folder, study_source
-from .plots import DPI
+from .common import CliError, check_out, guard, load_scene, read_scene, scene_folder, study_source
+from .plots import DPI, plot_title
 from .scheduler import open_executor, scheduler_option
 
 #: the panels of each figure: (runs.csv column, axis label)
@@ -85,7 +85,7 @@ def plot_key(path, rows, keys, key, title):
                    title="other settings", ncols=min(3, len(groups)))
     failed = sum(row["outcome"] != "ok" for row in rows)
     note = f"; × on the time panel: {failed} failed run(s)" if failed else ""
-    fig.suptitle(f"{title}\nsweep over {key}{note}", fontsize="medium")
+    fig.suptitle(f"{plot_title(title)}\nsweep over {key}{note}", fontsize="medium")
     write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI), binary=True)
     plt.close(fig)
 
@@ -118,6 +118,21 @@ def table(rows, keys):
     return lines
 
 
+def guard_variants(source, settings, grid, force):
+    """Refuse (exit 2) a sweep with a variant larger than the machine, before
+    any variant's mesh is built (:func:`~.common.guard`); ``source`` is the
+    decoded scene document."""
+    if force:
+        return
+    for values in variants(settings, "grid" if grid else "zip"):
+        try:
+            scene = scene_from_dict(variant_document(source, values))
+        except (SceneError, ValueError):
+            continue   # the sweep names the setting at fault
+        where = ", ".join(f"{k}={show(v)}" for k, v in values.items())
+        guard(scene, what=f"the variant {where}")
+
+
 @click.command()
 @click.argument("scene", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--set", "assignments", multiple=True, required=True, metavar="KEY=V1,V2,...",
@@ -133,7 +148,10 @@ def table(rows, keys):
 @scheduler_option("variants")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-sweep.")
-def sweep(scene, assignments, grid, jobs, scheduler, out):
+@click.option("--force", is_flag=True,
+              help="Run even when a variant's estimated memory or time exceeds what the "
+                   "machine has.")
+def sweep(scene, assignments, grid, jobs, scheduler, out, force):
     """Run SCENE (a TOML file) for every variant given by --set.
 
     Every variant's scene is checked before anything runs. Writes runs.csv
@@ -150,11 +168,14 @@ def sweep(scene, assignments, grid, jobs, scheduler, out):
     next run of the command.
     """
     name, text = read_scene(scene)
-    load_scene(text, scene_folder(scene))
+    load_scene(text, scene_folder(scene), force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-sweep"
+    check_out(out)
     try:
         settings = [parse_assignment(a) for a in assignments]
-        study = Sweep(study_source(text, scene_folder(scene)), settings, "grid" if grid else "zip", folder=out)
+        source = study_source(text, scene_folder(scene))
+        guard_variants(source, settings, grid, force)
+        study = Sweep(source, settings, "grid" if grid else "zip", folder=out)
         study.open()
     except StudyMismatch as err:
         raise CliError(f"--out {out} holds a different sweep ({err.difference}); "

@@ -63,13 +63,16 @@ def test_within_the_bound_the_same_scene_runs():
     assert solve(debonding(50)).success
 
 
-def test_non_finite_load_stops_at_step_zero():
-    # no contact boundary: before, a load 0/0 gave exit 0 and an all-NaN u
+def test_non_finite_load_between_the_checked_times_stops_at_its_step():
+    # no contact boundary: before, a load 0/0 gave exit 0 and an all-NaN u.
+    # Validation checks the loads at t = 0, T and 16 levels between (a 0/0
+    # is refused there, test_values.py); a load that is infinite at t_1 =
+    # 0.025 only, a level it does not sample, is caught by the scheme
     scene = scene_dict({"boundary": {"dirichlet": ["left"], "contact": []},
-                        "loads.body": ["0/0", "0"], "time.steps": 2})
+                        "loads.body": ["1/(t - 0.025)", "0"], "time.steps": 40})
     sol = solve(build_problem(scene_from_dict(scene)))
-    assert isinstance(sol.failure, InvalidState) and sol.failure.n == 0
-    assert "the load (body force" in str(sol.failure) and sol.t.size == 0
+    assert isinstance(sol.failure, InvalidState) and sol.failure.n == 1
+    assert "the load (body force" in str(sol.failure) and sol.t.size == 1
 
 
 def test_a_level_beyond_the_wall_is_named():

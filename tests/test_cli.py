@@ -1,4 +1,4 @@
-"""Tests for the ``adhcontact`` command line (SPEC.md, "Command line (firm)")."""
+"""Tests for the ``adhcontact`` command line (docs/outputs.md)."""
 
 import inspect
 import json
@@ -27,7 +27,7 @@ NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
              "iterations", "residual", "reactions", "contact_force"}
-SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "linear",
+SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "linear", "resources",
                 "iterations", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
                   "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",

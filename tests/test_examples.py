@@ -13,7 +13,7 @@ EXAMPLES = sorted((ROOT / "examples").glob("*.py"))
 #: a line each script must print: what it is for
 EXPECTED = {
     "run_scene.py": " 1.00 ",
-    "scene_in_code.py": "refused: time.steps: must be an integer >= 1, got 0",
+    "scene_in_code.py": "refused: time.steps: must be an integer in 1..1e+08, got 0",
     "parameter_study.py": "files: runs.csv in ",
     "plot_outputs.py": "beta_and_force.png: 21 levels",
 }

@@ -100,7 +100,7 @@ def test_shipped_default_scene_is_the_studies_copy():
     (("material", "E"), DELETE, "material.E: missing; a number is required"),
     (("material", "lam"), 1.0, "material.E: give exactly one pair"),
     (("time", "steps"), "ten", "time.steps: must be an integer"),
-    (("time", "steps"), 0, "time.steps: must be an integer >= 1"),
+    (("time", "steps"), 0, "time.steps: must be an integer in 1..1e+08, got 0"),
     (("time", "T"), -1.0, "time.T: must be > 0"),
     (("material", "E"), 0.0, "material.E: must be > 0"),
     (("material", "nu"), 0.5, "material.nu: must lie in (-1, 0.5)"),

@@ -1,0 +1,217 @@
+"""What a scene will need, estimated from the scene alone (nothing built).
+
+A scene can ask for more than the machine has: a mesh whose factors do
+not fit in memory, more time steps than a day holds, a history of every
+level larger than the disk. :func:`estimate` counts, from the scene's
+numbers only (before any mesh exists), the nodes, dofs, cells, contact
+nodes and unknowns, and the time levels, picks the linear backend the run
+would use (:func:`~adhesive_contact.linear_solvers.choose` for ``auto``),
+and estimates
+
+- memory: the process itself and the working memory of assembly, the
+  per-mesh operators (K_λ, K_μ, the strain map: about four
+  matrices of the step matrix's pattern), the factors of the step matrix
+  (:func:`~adhesive_contact.linear_solvers.factor_bytes`; about three
+  copies of the pattern for AMG), the dense Schur complement on the
+  contact unknowns (m² doubles), and what grows with the steps: u at every
+  level (kept for the outputs; a second copy for a function kernel's
+  history sum), β per contact facet and the gap per contact node at every
+  level;
+- time: the set-up (assembly and factorisation) and N steps, each two
+  solves with the factors plus a few dense Newton solves on the contact
+  unknowns (and, for a function kernel, a history sum over all previous
+  levels);
+- disk: the outputs (u and the cell stress per level in solution.h5, u
+  in solution.npz).
+
+The constants are rough (order of magnitude) and err on the high side;
+:func:`refusal` says when an estimate exceeds what the machine has
+(available memory, free disk) or a time limit.
+"""
+
+import math
+import os
+import shutil
+from dataclasses import asdict, dataclass
+
+from .linear_solvers import choose, factor_bytes
+from .scene import SceneError, nodes_of
+
+#: stored entries per node of a P1 stiffness row block, per component pair
+#: (neighbours + 1: 7 on the structured triangle meshes, 15 on the tetrahedra)
+PATTERN = {2: 7, 3: 15}
+#: cells per structured quadrilateral / hexahedron of the unrefined mesh
+CELLS_PER_BLOCK = {("rectangle", "diagonal"): 2, ("rectangle", "cross"): 4,
+                   ("box", "diagonal"): 6}
+BYTES_PER_ENTRY = 12          # a double and an index of a sparse entry
+#: measured on this code (one core, PARDISO): about 1.2 µs per dof for the
+#: two solves of a step at 1e5 dofs and 12 µs per dof of set-up; rounded up
+SECONDS_PER_DOF_STEP = 2e-6
+SECONDS_PER_DOF_SETUP = 2e-5
+SECONDS_PER_STEP = 5e-3       # the Python work of a step and its Newton iterations
+FLOPS = 2e9                   # dense Newton solves on the contact unknowns
+#: the process with its libraries loaded, and the working memory of assembly
+#: per dof (mesh, quadrature arrays, boundary): measured peak resident memory
+#: 100 MB at 1e3 dofs, 270–470 MB at 2.6e4–6.6e4 dofs (2D, PARDISO)
+BASE_BYTES = 150e6
+BYTES_PER_DOF = 4000
+NEWTON_ITERATIONS = 5         # per step, for the dense part of the estimate
+DAY = 86400.0
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """The size of a run and what it is expected to need (bytes, seconds)."""
+
+    nodes: int
+    dofs: int
+    cells: int
+    contact_nodes: int
+    contact_unknowns: int
+    levels: int
+    backend: str
+    backend_reason: str
+    memory_bytes: float
+    seconds: float
+    disk_bytes: float
+
+    def record(self):
+        """The estimate as a JSON-able dict."""
+        return asdict(self)
+
+    def describe(self):
+        """One phrase: the size and the estimated memory, time and disk."""
+        return (f"{self.dofs:.3g} dofs, {self.contact_unknowns:.3g} contact unknowns, "
+                f"{self.levels:.3g} time levels, {self.backend}: about "
+                f"{_bytes(self.memory_bytes)} of memory, {_duration(self.seconds)}, "
+                f"{_bytes(self.disk_bytes)} of output")
+
+
+def _bytes(n):
+    return f"{n / 1e9:.3g} GB" if n >= 1e8 else f"{n / 1e6:.3g} MB"
+
+
+def _duration(seconds):
+    if seconds >= DAY:
+        return f"{seconds / DAY:.3g} days"
+    if seconds >= 3600:
+        return f"{seconds / 3600:.3g} h"
+    return f"{seconds:.3g} s"
+
+
+def _contact_nodes(scene):
+    """Nodes on the contact sides (corners shared by two sides counted twice)."""
+    if not scene.has_contact_terms:
+        return 0
+    n = [c * 2**scene.mesh.refine for c in scene.mesh.cells]
+    axis = {"left": 0, "right": 0, "bottom": 1, "top": 1, "front": 2, "back": 2}
+    return sum(math.prod(m + 1 for i, m in enumerate(n) if i != axis[side])
+               for side in scene.contact_sides)
+
+
+def _file_counts(scene):
+    """(nodes, cells, contact nodes) of a file mesh after its refinements: the
+    file's own counts (read by meshio, not built) times 2^d per refinement;
+    the contact nodes bounded by a boundary's share, nodes^((d−1)/d) per side."""
+    from .meshes.gmsh_file import MeshFileError, _read
+
+    d, spec = scene.dim, scene.mesh
+    try:
+        data = _read(spec.path)
+    except MeshFileError as err:
+        raise SceneError("mesh.file", str(err)) from None
+    growth = (2**d) ** spec.refine
+    nodes = len(data.points) * growth
+    cells = sum(len(block.data) for block in data.cells
+                if block.dim == d) * growth
+    contact = (len(scene.contact_sides) * round(nodes ** ((d - 1) / d))
+               if scene.has_contact_terms else 0)
+    return nodes, cells, contact
+
+
+def estimate(scene, memory_limit=None):
+    """The :class:`Estimate` of a run of ``scene`` (see the module docstring).
+
+    ``memory_limit`` is passed to the backend choice for ``linear = "auto"``
+    (default: its own, half the physical memory)."""
+    d, spec = scene.dim, scene.mesh
+    if spec.domain == "file":   # counts read off the file; refinement ×2^d (nodes ≈ cells/2^(d-1))
+        nodes, cells, contact_nodes = _file_counts(scene)
+    else:
+        nodes = nodes_of(spec.cells, spec.refine, spec.pattern)
+        cells = (CELLS_PER_BLOCK[(spec.domain, spec.pattern)] * math.prod(spec.cells)
+                 * (2**d) ** spec.refine)
+        contact_nodes = _contact_nodes(scene)
+    dofs = d * nodes
+    nnz = d * d * PATTERN[d] * nodes
+    unknowns = d * contact_nodes
+    levels = scene.steps + 1
+    backend = scene.solver.linear
+    reason = f"method {backend!r} was asked for."
+    if backend == "auto":
+        backend, reason = choose(dofs, nnz, d, memory_limit)
+    factors = (3 * BYTES_PER_ENTRY * nnz if backend == "amg"
+               else factor_bytes(dofs, nnz, d, backend))
+    history = 8.0 * levels * (dofs * (2 if _function_kernel(scene) else 1) + 2 * contact_nodes)
+    memory = (BASE_BYTES + BYTES_PER_DOF * dofs + 4 * BYTES_PER_ENTRY * nnz + factors
+              + 8.0 * unknowns**2 + history)
+    step = (SECONDS_PER_STEP + SECONDS_PER_DOF_STEP * dofs + NEWTON_ITERATIONS * unknowns**3 / (3 * FLOPS)
+            + (1e-9 * dofs * levels / 2 if _function_kernel(scene) else 0.0))
+    seconds = SECONDS_PER_DOF_SETUP * dofs + unknowns**3 / FLOPS + levels * step
+    disk = 8.0 * levels * (2 * dofs + 10 * cells)
+    return Estimate(nodes, dofs, cells, contact_nodes, unknowns, levels, backend, reason,
+                    float(memory), float(seconds), float(disk))
+
+
+def _function_kernel(scene):
+    return scene.memory is not None and scene.memory.kernel == "function"
+
+
+def available_memory():
+    """Bytes of memory available now (MemAvailable of /proc/meminfo), else
+    the physical memory, else 4 GiB."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return 4 * 2**30
+
+
+def free_disk(folder):
+    """Free bytes on the file system of ``folder`` or its nearest existing
+    parent (None when it cannot be told)."""
+    path = os.path.abspath(folder)
+    while not os.path.exists(path) and os.path.dirname(path) != path:
+        path = os.path.dirname(path)
+    try:
+        return shutil.disk_usage(path).free
+    except OSError:
+        return None
+
+
+def refusal(est, memory=None, seconds=DAY, disk=None):
+    """Why a run of estimate ``est`` should not start, or None.
+
+    Parameters
+    ----------
+    est : Estimate
+    memory : bytes the run may take (default :func:`available_memory`)
+    seconds : the longest run allowed without asking (default a day)
+    disk : free bytes where the outputs go, or None not to check
+    """
+    memory = available_memory() if memory is None else memory
+    if est.memory_bytes > memory:
+        return (f"it would need about {_bytes(est.memory_bytes)} of memory, more than the "
+                f"{_bytes(memory)} available")
+    if est.seconds > seconds:
+        return f"it would run for about {_duration(est.seconds)}, more than {_duration(seconds)}"
+    if disk is not None and est.disk_bytes > disk:
+        return (f"its outputs would take about {_bytes(est.disk_bytes)}, more than the "
+                f"{_bytes(disk)} free")
+    return None
