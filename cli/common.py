@@ -14,9 +14,6 @@ from pathlib import Path
 
 import click
 
-from adhesive_contact import SceneError, build_problem, parse_scene
-from adhesive_contact.resources import estimate, free_disk, refusal
-
 DEFAULT_SCENE = "default_scene.toml"
 
 
@@ -57,6 +54,8 @@ def load_scene(text, base_dir=None, force=False, out=None):
     ``load_scene(path)`` does; a bad scene is a :class:`CliError` (exit 2),
     and so is one larger than the machine unless ``force`` (:func:`guard`,
     before the mesh is built)."""
+    from adhesive_contact import SceneError, build_problem, parse_scene
+
     try:
         scene = parse_scene(text, base_dir)
         guard(scene, force, out)
@@ -89,6 +88,8 @@ def guard(scene, force=False, out=None, what="the scene"):
     checked), None not to check the disk."""
     if force:
         return
+    from adhesive_contact.resources import estimate, free_disk, refusal
+
     est = estimate(scene)
     reason = refusal(est, disk=None if out is None else free_disk(out))
     if reason:

@@ -13,6 +13,7 @@ line ``warning: ...`` each on stderr before the time loop, and the run
 goes on."""
 
 import contextlib
+import importlib
 import signal
 import sys
 import threading
@@ -20,16 +21,24 @@ from pathlib import Path
 
 import click
 
-from adhesive_contact import solve
-from adhesive_contact.io import StreamingRecorder
-from adhesive_contact.postprocess import beta_mean
-from adhesive_contact.sanity import magnitude_warnings
-from adhesive_contact.scheme import STOPPED
+from .common import (
+    CliError,
+    check_out,
+    echo_warnings,
+    load_scene,
+    read_scene,
+    scene_folder,
+)
 
-from .common import CliError, check_out, echo_warnings, load_scene, read_scene, scene_folder
-from .converge import converge
-from .output import staged_output, write_results
-from .sweep import sweep
+#: commands imported only when run (the library, matplotlib and dask take a
+#: second to import; ``adhcontact --help`` should not wait for them):
+#: name -> (module, attribute, short help)
+LAZY_COMMANDS = {
+    "converge": ("adhesive_contact_cli.converge", "converge",
+                 "Convergence study of SCENE (a TOML file) in h, k or both."),
+    "sweep": ("adhesive_contact_cli.sweep", "sweep",
+              "Run SCENE (a TOML file) for every variant given by --set."),
+}
 
 
 class OneLineGroup(click.Group):
@@ -85,7 +94,28 @@ def interruptible():
         signal.signal(signal.SIGINT, previous)
 
 
-@click.group(cls=OneLineGroup)
+class LazyGroup(OneLineGroup):
+    """A group whose commands of :data:`LAZY_COMMANDS` are imported when used;
+    its help lists them with their short help without importing them."""
+
+    def list_commands(self, ctx):
+        return sorted([*super().list_commands(ctx), *LAZY_COMMANDS])
+
+    def get_command(self, ctx, name):
+        if name in LAZY_COMMANDS:
+            module, attribute, _ = LAZY_COMMANDS[name]
+            return getattr(importlib.import_module(module), attribute)
+        return super().get_command(ctx, name)
+
+    def format_commands(self, ctx, formatter):
+        rows = [(name, LAZY_COMMANDS[name][2] if name in LAZY_COMMANDS else
+                 super(LazyGroup, self).get_command(ctx, name).get_short_help_str(60))
+                for name in self.list_commands(ctx)]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup)
 @click.version_option(package_name="adhesive_contact")
 def main():
     """Quasistatic adhesive contact of a viscoelastic body with long memory."""
@@ -106,6 +136,14 @@ def solve_command(scene, out, force):
     Writes summary.json, solution.npz, solution.xdmf/.h5 (ParaView) and PNG
     plots into the output folder.
     """
+    from adhesive_contact import solve
+    from adhesive_contact.io import StreamingRecorder
+    from adhesive_contact.postprocess import beta_mean
+    from adhesive_contact.sanity import magnitude_warnings
+    from adhesive_contact.scheme import STOPPED
+
+    from .output import staged_output, write_results
+
     name, text = read_scene(scene)
     out = Path(out) if out is not None else Path.cwd() / name
     parsed, problem = load_scene(text, scene_folder(scene), force, out)
@@ -161,5 +199,3 @@ def solve_command(scene, out, force):
     click.echo(f"  wrote {out}/: {', '.join(files)}")
 
 
-main.add_command(converge)
-main.add_command(sweep)

@@ -35,6 +35,7 @@ from adhesive_contact.storage import json_number, write_json
 from . import plots
 from .postprocess import smallness_record, step_records
 
+
 def summary(solution):
     """The ``summary.json`` document (a dict of plain JSON types)."""
     problem = solution.problem

@@ -26,7 +26,15 @@ from adhesive_contact.studies import (
 from adhesive_contact.studies.executors import ClusterError
 from adhesive_contact.studies.sweep import LOST, show, variant_document, variants
 
-from .common import CliError, check_out, guard, load_scene, read_scene, scene_folder, study_source
+from .common import (
+    CliError,
+    check_out,
+    guard,
+    load_scene,
+    read_scene,
+    scene_folder,
+    study_source,
+)
 from .plots import DPI, plot_title
 from .scheduler import open_executor, scheduler_option
 
