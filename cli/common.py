@@ -111,6 +111,28 @@ def check_out(out):
                        "a writable folder)", 2)
 
 
+def open_study(make, out, kind, option=lambda key: f"--{key}"):
+    """``make()`` a study and open its folder ``out``; what the study layer
+    refuses becomes one line, exit 2 (``option`` names a study argument as
+    the command's option)."""
+    from adhesive_contact import SceneError
+    from adhesive_contact.studies import StudyError, StudyFolderError, StudyMismatch
+
+    try:
+        study = make()
+        study.open()
+    except StudyMismatch as err:
+        raise CliError(f"--out {out} holds a different {kind} ({err.difference}); "
+                       "use another --out or remove it", 2) from None
+    except StudyFolderError as err:
+        raise CliError(f"--out: {err.message}", 2) from None
+    except StudyError as err:
+        raise CliError(f"{option(err.key)}: {err.message}", 2) from None
+    except SceneError as err:
+        raise CliError(str(err), 2) from None
+    return study
+
+
 def echo_warnings(problem):
     """One line ``warning: ...`` on stderr per thing the theory does not cover."""
     for warning in problem.warnings():

@@ -23,9 +23,6 @@ from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     ConvergenceStudy,
     RunFailed,
-    StudyError,
-    StudyFolderError,
-    StudyMismatch,
 )
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
 from adhesive_contact.studies.executors import ClusterError
@@ -36,6 +33,7 @@ from .common import (
     echo_warnings,
     guard,
     load_scene,
+    open_study,
     read_scene,
     scene_folder,
     study_source,
@@ -245,19 +243,10 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     _, problem = load_scene(text, scene_folder(scene), force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-converge-{param}"
     check_out(out)
-    try:
-        study = ConvergenceStudy(study_source(text, scene_folder(scene)), param, levels,
-                                 reference, folder=out, ref_h=ref_h,
-                                 ref_k=ref_k, refine=base_refine, steps=base_steps,
-                                 scene_file=str(scene))
-        study.open()
-    except StudyMismatch as err:
-        raise CliError(f"--out {out} holds a different study ({err.difference}); "
-                       "use another --out or remove it", 2) from None
-    except StudyFolderError as err:
-        raise CliError(f"--out: {err.message}", 2) from None
-    except StudyError as err:
-        raise CliError(f"{option_name(err.key)}: {err.message}", 2) from None
+    study = open_study(lambda: ConvergenceStudy(
+        study_source(text, scene_folder(scene)), param, levels, reference, folder=out,
+        ref_h=ref_h, ref_k=ref_k, refine=base_refine, steps=base_steps,
+        scene_file=str(scene)), out, "study", option_name)
     guard(study.reference_scene or level_scene(study.scene, param, levels - 1), force,
           what="the largest run of the study")
     executor = open_executor(scheduler, jobs)

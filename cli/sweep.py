@@ -17,9 +17,6 @@ import numpy as np
 from adhesive_contact import SceneError, scene_from_dict
 from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
-    StudyError,
-    StudyFolderError,
-    StudyMismatch,
     Sweep,
     parse_assignment,
 )
@@ -31,6 +28,7 @@ from .common import (
     check_out,
     guard,
     load_scene,
+    open_study,
     read_scene,
     scene_folder,
     study_source,
@@ -179,21 +177,13 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
     load_scene(text, scene_folder(scene), force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-sweep"
     check_out(out)
-    try:
+    def make():
         settings = [parse_assignment(a) for a in assignments]
         source = study_source(text, scene_folder(scene))
         guard_variants(source, settings, grid, force)
-        study = Sweep(source, settings, "grid" if grid else "zip", folder=out)
-        study.open()
-    except StudyMismatch as err:
-        raise CliError(f"--out {out} holds a different sweep ({err.difference}); "
-                       "use another --out or remove it", 2) from None
-    except StudyFolderError as err:
-        raise CliError(f"--out: {err.message}", 2) from None
-    except StudyError as err:
-        raise CliError(f"--{err.key}: {err.message}", 2) from None
-    except SceneError as err:
-        raise CliError(str(err), 2) from None
+        return Sweep(source, settings, "grid" if grid else "zip", folder=out)
+
+    study = open_study(make, out, "sweep")
     executor = open_executor(scheduler, jobs)
     for warning in dict.fromkeys(w for _, w in study.warnings):
         runs = [str(i) for i, w in study.warnings if w == warning]

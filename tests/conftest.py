@@ -74,6 +74,17 @@ def prony(*terms):
             "terms": [{"E": E, "nu": nu, "tau": tau} for E, nu, tau in terms]}
 
 
+def glued_contact(gap=0.05):
+    """The [contact] table of the glued strip: adhesive compliance, slip
+    weakening and an adhesive spring, Frémond bonding, a wall at ``gap``."""
+    return {"gap": gap,
+            "normal": law("adhesive_compliance", c=1e4, gamma=5e3, L=0.01),
+            "friction": [law("nonmonotone", a=2.0, b=1.0, alpha=50.0),
+                         law("adhesive_spring", gamma=2e3, L=0.01)],
+            "bonding": {"law": "fremond", "beta0": 1.0, "gamma_nu": 1e5,
+                        "gamma_tau": 5e4, "eps_a": 0.0, "L": 0.01}}
+
+
 def to_toml(data):
     """The TOML text of a scene document (tomllib reads, but cannot write).
 

@@ -9,19 +9,14 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import law, prony, scene_dict
+from conftest import glued_contact, prony, scene_dict
 
 from adhesive_contact import build_problem, scene_from_dict, solve
 from adhesive_contact.linear_solvers import pardiso
 
 GLUED = {
     "memory": prony((200.0, 0.3, 0.5)),
-    "contact": {"gap": 0.05,
-                "normal": law("adhesive_compliance", c=1e4, gamma=5e3, L=0.01),
-                "friction": [law("nonmonotone", a=2.0, b=1.0, alpha=50.0),
-                             law("adhesive_spring", gamma=2e3, L=0.01)],
-                "bonding": {"law": "fremond", "beta0": 1.0, "gamma_nu": 1e5,
-                            "gamma_tau": 5e4, "eps_a": 0.0, "L": 0.01}},
+    "contact": glued_contact(),
     "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
     "time": {"T": 1.0, "steps": 20},
 }

@@ -6,7 +6,7 @@ leaving the kink not held, step 16 cycled between two iterates until the
 iteration limit)."""
 
 import numpy as np
-from conftest import law, prony, scene_dict
+from conftest import glued_contact, prony, scene_dict
 
 from adhesive_contact import build_problem, scene_from_dict, solve
 
@@ -16,12 +16,7 @@ BLOCK_3D = scene_dict({
     "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
     "memory": prony((200.0, 0.3, 0.5)),
     "loads": {"traction": {"right": ["7*t", "14*t", "0"]}},
-    "contact": {"gap": 0.05,
-                "normal": law("adhesive_compliance", c=1e4, gamma=5e3, L=0.01),
-                "friction": [law("nonmonotone", a=2.0, b=1.0, alpha=50.0),
-                             law("adhesive_spring", gamma=2e3, L=0.01)],
-                "bonding": {"law": "fremond", "beta0": 1.0, "gamma_nu": 1e5,
-                            "gamma_tau": 5e4, "eps_a": 0.0, "L": 0.01}},
+    "contact": glued_contact(),
     "time": {"T": 1.0, "steps": 20},
 })
 
