@@ -34,6 +34,8 @@ from .common import (
 #: second to import; ``adhcontact --help`` should not wait for them):
 #: name -> (module, attribute, short help)
 LAZY_COMMANDS = {
+    "check": ("adhesive_contact_cli.check", "check",
+              "Validate SCENE (the built-in default if omitted) and print what a run would be."),
     "converge": ("adhesive_contact_cli.converge", "converge",
                  "Convergence study of SCENE (a TOML file) in h, k or both."),
     "sweep": ("adhesive_contact_cli.sweep", "sweep",

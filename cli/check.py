@@ -1,0 +1,49 @@
+"""``adhcontact check``: validate a scene and show what a run would be,
+without running it: the resolved scene (every default filled in), the mesh
+and contact sizes, the estimate of memory, time and output, the explicit
+Euler bound of the bonding law and the smallness figures."""
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from .common import load_scene, read_scene, scene_folder
+
+
+@click.command()
+@click.argument("scene", required=False, type=click.Path(dir_okay=False, path_type=Path))
+def check(scene):
+    """Validate SCENE (the built-in default if omitted) and print what a run would be."""
+    from adhesive_contact.resources import estimate
+    from adhesive_contact.storage import plain
+
+    name, text = read_scene(scene)
+    parsed, problem = load_scene(text, scene_folder(scene), force=True)
+    est = estimate(parsed)
+    boundary = problem.boundary
+    click.echo(f"{name}: valid scene ({parsed.title})")
+    click.echo(f"  mesh: {problem.mesh.p.shape[1]} nodes, {problem.mesh.t.shape[1]} cells, "
+               f"{problem.ndofs} dofs ({problem.free.size} free); "
+               + ("no contact boundary" if boundary is None else
+                  f"{boundary.facets.size} contact facets, {boundary.nodes.size} contact "
+                  f"nodes, {problem.columns.size} contact unknowns"))
+    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}")
+    click.echo(f"  estimate: {est.describe()}")
+    if problem.bonding is not None:
+        bound = problem.bonding.stable_step()
+        click.echo(f"  explicit Euler bound of the bonding law: k <= {bound:.4g} "
+                   f"(k = {parsed.k:.4g}: {'within' if parsed.k <= bound else 'beyond'}; "
+                   f"integrator {parsed.contact.integrator})")
+    small = problem.smallness
+    if small is not None:
+        click.echo(f"  smallness: m_A = {small['m_A']:.4g}; error estimate needs > "
+                   f"{small['rhs']:.4g} ({'holds' if small['holds'] else 'does not hold'}); "
+                   f"step energy {'convex' if small['step_energy_convex'] else 'may be nonconvex'}"
+                   f" (m_c c_e^2 = {small['convexity_rhs']:.4g})")
+    for warning in problem.warnings():
+        click.echo(f"  warning: {' '.join(str(warning).split())}")
+    click.echo("  resolved scene:")
+    json.dump(plain(parsed.resolved), sys.stdout, indent=1)
+    click.echo()

@@ -1,0 +1,38 @@
+"""``adhcontact check``: validates without running, prints the sizes, the
+estimate, the bonding bound and the smallness figures and the resolved
+scene, and writes nothing; a bad scene is exit 2, one line."""
+
+import json
+from pathlib import Path
+
+from adhesive_contact_cli.main import main
+from click.testing import CliRunner
+from conftest import scene_dict, to_toml
+
+from adhesive_contact import load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_check_prints_what_a_run_would_be_and_writes_nothing(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = ROOT / "studies/scenes/debonding.toml"
+    result = CliRunner().invoke(main, ["check", str(path)])
+    assert result.exit_code == 0, result.output
+    out = result.stdout
+    assert "debonding: valid scene" in out
+    assert "80 contact facets, 80 contact nodes, 160 contact unknowns" in out
+    assert "explicit Euler bound of the bonding law: k <= 0.06667 (k = 0.02: within" in out
+    assert "smallness: m_A = 769.2" in out and "estimate: " in out
+    resolved = json.loads(out[out.index("{"):])
+    assert resolved == json.loads(json.dumps(load_scene(path).resolved))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_check_refuses_a_bad_scene_with_one_line(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(to_toml(scene_dict({"time.steps": 0})))
+    result = CliRunner().invoke(main, ["check", str(path)])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: time.steps: must be an integer in 1..1e+08, got 0"]
