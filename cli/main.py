@@ -14,6 +14,7 @@ goes on."""
 
 import contextlib
 import importlib
+import io
 import signal
 import sys
 import threading
@@ -132,7 +133,9 @@ def main():
 @click.option("--force", is_flag=True,
               help="Run even when the estimated memory, time or output size exceeds what "
                    "the machine has (summary.json records the estimate).")
-def solve_command(scene, out, force):
+@click.option("--quiet", "-q", is_flag=True,
+              help="No warnings on stderr (they stay in summary.json) and no progress bar.")
+def solve_command(scene, out, force, quiet):
     """Run SCENE (a TOML file; the built-in default scene if omitted).
 
     Writes summary.json, solution.npz, solution.xdmf/.h5 (ParaView) and PNG
@@ -150,21 +153,24 @@ def solve_command(scene, out, force):
     out = Path(out) if out is not None else Path.cwd() / name
     parsed, problem = load_scene(text, scene_folder(scene), force, out)
     check_out(out)
-    echo_warnings(problem)
+    if not quiet:
+        echo_warnings(problem)
 
     files, failures = [], []
     try:
         with staged_output(out) as folder:
             recorder = StreamingRecorder(problem, folder)   # levels to disk as computed
             try:
-                with click.progressbar(length=parsed.steps + 1, file=sys.stderr,
+                with click.progressbar(length=parsed.steps + 1,
+                                       file=io.StringIO() if quiet else sys.stderr,
                                        label=f"{name}: {parsed.steps} steps") as bar, \
                         interruptible() as interrupted:
                     solution = solve(problem, recorder=recorder,
                                      progress=lambda n, N: bar.update(1) or interrupted())
                 if solution.t.size:   # the levels that converged, partial or not
                     for warning in magnitude_warnings(solution):
-                        click.echo(f"warning: {warning}", err=True)
+                        if not quiet:
+                            click.echo(f"warning: {warning}", err=True)
                     files = write_results(solution, folder, failures)
             finally:
                 recorder.close()
@@ -172,7 +178,8 @@ def solve_command(scene, out, force):
     except OSError as err:
         raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
     for failure in failures:
-        click.echo(f"warning: {failure}", err=True)
+        if not quiet:
+            click.echo(f"warning: {failure}", err=True)
     if solution.status == STOPPED:
         raise CliError(f"interrupted after step {solution.steps} (t = {solution.t[-1]:g}); "
                        f"the {solution.t.size} levels done were written to {out}/ "

@@ -36,3 +36,16 @@ def test_check_refuses_a_bad_scene_with_one_line(tmp_path):
     assert result.exit_code == 2
     assert result.stderr.strip().splitlines() == [
         "error: time.steps: must be an integer in 1..1e+08, got 0"]
+
+
+def test_quiet_solve_prints_no_warning_but_keeps_them(tmp_path):
+    # the debonding scene warns (its smallness condition fails)
+    path = ROOT / "studies/scenes/debonding.toml"
+    out = tmp_path / "out"
+    loud = CliRunner().invoke(main, ["solve", str(path), "--out", str(tmp_path / "loud")])
+    quiet = CliRunner().invoke(main, ["solve", str(path), "--out", str(out), "--quiet"])
+    assert loud.exit_code == quiet.exit_code == 0
+    assert "warning: " in loud.stderr and "steps" in loud.stderr
+    assert quiet.stderr == ""
+    warnings = json.loads((out / "summary.json").read_text())["warnings"]
+    assert warnings and all(w.split()[0] in loud.stderr for w in warnings)
