@@ -19,6 +19,7 @@ absent; ``[loads]``, ``[contact]``, ``[solver]`` and ``[output]`` only
 set values that have defaults and read as those defaults when absent.
 """
 
+import difflib
 import hashlib
 import math
 import tomllib
@@ -367,6 +368,25 @@ def _exact_record(exact):
 # ---------------------------------------------------------------- reading tables
 
 
+#: every key of a table whose reader asks for some only in some branches
+#: (a law's parameters are named by the law's reader; [mesh] and [memory]
+#: are read whole for their domain or kernel)
+KNOWN_KEYS = {
+    "": {"title", "dim", "mesh", "boundary", "material", "memory", "loads", "contact",
+         "time", "solver", "output", "exact"},
+    "boundary": {"dirichlet", "contact", "displacement"},
+    "material": {"E", "nu", "lam", "mu"},
+    "loads": {"body", "traction"},
+    "contact": {"gap", "foundation", "quadrature", "order", "normal", "friction", "bonding"},
+    "contact.foundation": {"shape", "point", "normal", "radius", "axis"},
+    "contact.bonding": {"law", "beta0", "integrator", "gamma_nu", "gamma_tau", "eps_a", "L"},
+    "time": {"T", "steps"},
+    "solver": {"method", "tol", "max_iter", "linear", "penalty", "smoothing"},
+    "output": {"probes"},
+    "exact": {"u", "beta", "multiplier"},
+}
+
+
 class _Table:
     """A TOML table being read: typed access, and unknown keys reported."""
 
@@ -402,9 +422,13 @@ class _Table:
     def finish(self):
         unknown = sorted(set(self.data) - self.used)
         if unknown:
-            allowed = ", ".join(sorted(self.used)) or "none"
-            raise SceneError(self.key(unknown[0]),
-                             f"unknown key; allowed here: {allowed}")
+            # a known key given where this table's branch does not take it
+            # (penalty without the penalty method) is not offered back
+            allowed = sorted(self.used | (KNOWN_KEYS.get(self.path, set()) - set(self.data)))
+            close = difflib.get_close_matches(unknown[0], allowed, n=1, cutoff=0.6)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise SceneError(self.key(unknown[0]), f"unknown key{hint}; allowed here: "
+                             f"{', '.join(allowed) or 'none'}")
 
 
 def _show(value):

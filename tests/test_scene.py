@@ -180,3 +180,19 @@ def test_initial_bonding_is_the_facet_mean():
     x = problem.mesh.p[0, nodes]
     # P_B of a linear function is its value at the facet midpoint
     assert np.allclose(problem.beta0, x.mean(axis=0) / 2, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"contact": {"bonding": {"law": "none", "beta_0": 0.5}}},
+     "contact.bonding.beta_0: unknown key (did you mean 'beta0'?); allowed here: L, beta0, "
+     "eps_a, gamma_nu, gamma_tau, integrator, law"),
+    ({"loads": {"bdy": ["0", "0"]}},
+     "loads.bdy: unknown key (did you mean 'body'?); allowed here: body, traction"),
+    ({"contact": {"gapp": 0.1}},
+     "contact.gapp: unknown key (did you mean 'gap'?); allowed here: bonding, foundation, "
+     "friction, gap, normal, order, quadrature"),
+])
+def test_unknown_key_lists_every_allowed_key_and_the_closest(changes, message):
+    with pytest.raises(SceneError) as info:
+        scene_from_dict(scene_dict(changes))
+    assert str(info.value) == message
