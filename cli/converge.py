@@ -280,6 +280,8 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
                f"computed now, {levels - computed} loaded")
     for line in table(document):
         click.echo("  " + line)
+    for warning in document.get("warnings", []):
+        click.echo(f"warning: {warning}", err=True)
     click.echo(f"  wrote {out}/: {', '.join(files)}")
 
 

@@ -122,6 +122,39 @@ def results(records, param, reference_info):
             "reference": reference_info}
 
 
+#: pairwise rates further apart than this, or any below 0, make a fit doubtful
+RATE_SPREAD = 0.5
+
+
+def trust(document):
+    """Why the study's fitted rates should not be trusted, one sentence each
+    (empty when nothing is wrong): errors E that do not decrease from a
+    level to the next, pairwise rates that scatter (one below 0, or further
+    apart than :data:`RATE_SPREAD`), a fine reference too close to the
+    finest level (fewer than 2 extra refinements in h, 4× the steps in k)."""
+    out = []
+    levels = document["levels"]
+    for a, b in zip(levels[:-1], levels[1:]):
+        if not (b["E"] is not None and a["E"] is not None and b["E"] < a["E"]):
+            out.append(f"E does not decrease from level {a['level']} to {b['level']} "
+                       f"({a['E']:.3g} to {b['E']:.3g})")
+    pairwise = [row["rate_E"] for row in levels if row["rate_E"] is not None]
+    if pairwise and (min(pairwise) < 0 or max(pairwise) - min(pairwise) > RATE_SPREAD):
+        out.append(f"the pairwise rates of E scatter from {min(pairwise):.2f} to "
+                   f"{max(pairwise):.2f}: the fitted rate is not a trustworthy summary")
+    ref = document.get("reference") or {}
+    if ref.get("kind") == "fine":
+        if document["param"] in ("h", "hk") and (ref.get("ref_h") or 0) < 2:
+            out.append(f"the fine reference is refined only {ref.get('ref_h')} more times than "
+                       "the finest level: its own error biases the finest errors (use "
+                       "--ref-h 2 or more)")
+        if document["param"] in ("k", "hk") and (ref.get("ref_k") or 0) < 2:
+            out.append(f"the fine reference has only 2**{ref.get('ref_k')} times the steps of "
+                       "the finest level: its own error biases the finest errors (use "
+                       "--ref-k 2 or more)")
+    return out
+
+
 def error_rows(document):
     """The rows of ``errors.csv`` (:data:`CSV_COLUMNS`), one per level: floats
     as repr, None (a rate_E on the first level, a NaN) as an empty cell."""
@@ -369,6 +402,8 @@ class ConvergenceStudy(Study):
         if self.reference == "fine":
             info["h"] = records[-1]["h"] / 2 ** self.ref_h
         document = results(records, self.param, info)
+        document["warnings"] = trust(document)
+        document["trustworthy"] = not document["warnings"]
         files = ["errors.csv", "rates.json"]
         write_errors_csv(self.folder / files[0], document)
         write_json(self.folder / files[1], document)
