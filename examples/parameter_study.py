@@ -1,9 +1,9 @@
-"""A small parameter study: the default scene for three foundation stiffnesses.
+"""A small parameter study: the block scene for three foundation stiffnesses.
 
     python examples/parameter_study.py [FOLDER]
 
 Runs adhesive_contact.studies.Sweep over contact.normal.c on a coarse copy
-of studies/scenes/default.toml and prints one line per run from its
+of studies/scenes/block.toml and prints one line per run from its
 records (runs.csv holds the same). The study is kept in FOLDER (default: a
 temporary folder, removed at the end); run again with the same FOLDER, it
 resumes and computes nothing.
@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main(folder):
-    document = tomllib.loads((ROOT / "studies" / "scenes" / "default.toml").read_text())
+    document = tomllib.loads((ROOT / "studies" / "scenes" / "block.toml").read_text())
     document["mesh"]["cells"] = [16, 8]          # coarse and short: a few tenths of a second
     document["time"]["steps"] = 8
     sweep = Sweep(document, [("contact.normal.c", [1e3, 1e4, 1e5])], folder=folder)

@@ -440,11 +440,11 @@ def test_fine_reference_in_3d_with_contact(tmp_path):
 
 
 def test_a_study_too_large_for_the_machine_is_refused(tmp_path):
-    """The default scene (1122 dofs) in h over 5 levels has a fine reference
+    """The block scene (1122 dofs) in h over 5 levels has a fine reference
     of 1122 · 4⁶ ≈ 4.6e6 dofs: refused before anything runs or is written."""
     scene = tmp_path / "default.toml"
     scene.write_text((Path(__file__).resolve().parents[1] / "studies" / "scenes"
-                      / "default.toml").read_text())
+                      / "block.toml").read_text())
     result = run(scene, "--param", "h", "--out", tmp_path / "out")
     assert_one_line_error(result, 2, "--levels: the fine reference would have about 4.6e+06 dofs")
     assert not (tmp_path / "out").exists()

@@ -41,7 +41,7 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-SCENE = HERE.parent / "scenes" / "default.toml"
+SCENE = HERE.parent / "scenes" / "block.toml"
 COLUMNS = ("steps", "mode", "workers", "runs", "validate_s", "run_s", "runs_s", "mean_run_s",
            "validate_per_run_s", "startup_s", "steady_per_run_s", "machinery_per_run_s",
            "overhead_per_run_s", "validate_pct", "steady_pct", "machinery_pct", "overhead_pct")
