@@ -82,18 +82,22 @@ class Problem:
         out = []
         s = self.smallness
         if s is not None and not s["holds"]:
-            tail = ("the step energy is still strictly convex (m_A > m_c c_e^2), so each "
-                    "step has one solution" if s["step_energy_convex"] else
-                    "the step energy may be nonconvex: the solver may fail or pick one of "
-                    "several solutions")
-            out.append(f"smallness condition of docs/model.md §3 does not hold: m_A = "
-                       f"{s['m_A']:.4g} <= (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}; uniqueness "
-                       f"is not guaranteed by the theory; {tail}")
+            tail = ("each step still has one solution (its energy is convex)"
+                    if s["step_energy_convex"] else
+                    "a step may have several solutions and the solver may pick any or fail")
+            out.append(f"the smallness condition of the error estimate does not hold "
+                       f"(m_A = {s['m_A']:.4g} against (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}): "
+                       f"the theory does not promise a unique solution or first-order "
+                       f"convergence here, and {tail}; softer contact laws or a stiffer "
+                       f"body move the scene inside it "
+                       f"(docs/model.md#the-three-smallness-conditions)")
         if (self.bonding is not None and self.scene.contact.integrator == "explicit"
                 and self.scene.k > self.bonding.stable_step()):
-            out.append(f"time step k = {self.scene.k:.4g} exceeds the explicit Euler bound "
+            out.append(f"the time step k = {self.scene.k:.4g} exceeds the explicit Euler bound "
                        f"1/((gamma_nu + gamma_tau) L^2) = {self.bonding.stable_step():.4g} of "
-                       f"the bonding law: beta may overshoot below 0; use more steps")
+                       f"the bonding law, so beta may leave [0, 1] and the run stop: use more "
+                       f"steps or another contact.bonding.integrator "
+                       f"(docs/conventions.md#the-explicit-euler-bound-on-the-time-step)")
         return out
 
     @property
