@@ -17,88 +17,34 @@ import dask
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
+from conftest import law, prony, scene_dict, to_toml
 from distributed import LocalCluster
 
 import adhesive_contact.studies.executors as executors
 from adhesive_contact.studies import ClusterError, Sweep, dask_executor
 from adhesive_contact.studies.sweep import _compute_run, _setup
 
-
 # the test_sweep block (8x4 cells, 3 steps): c = 5000 with one Newton
 # iteration allowed fails at step 1, so the table has a failed row too
-BLOCK = """\
-title = "test block"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [2.0, 1.0]
-cells = [8, 4]
-
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[loads]
-body = ["0", "-400*t"]
-
-[contact]
-gap = "0.002 + 0.01*(x - 1)**2"
-
-[contact.normal]
-law = "compliance"
-c = 5000.0
-
-[time]
-T = 1.0
-steps = 3
-"""
+BLOCK = to_toml(scene_dict({
+    "title": "test block",
+    "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [8, 4]},
+    "memory": prony((200.0, 0.3, 0.5)),
+    "loads": {"body": ["0", "-400*t"]},
+    "contact": {"gap": "0.002 + 0.01*(x - 1)**2", "normal": law("compliance", c=5000.0)},
+    "time.steps": 3,
+}))
 
 # the test_converge block on a compliant wall: a k-study against a fine
 # reference, which is sent to the workers with the context
-CONTACT = """\
-title = "small block on a compliant wall"
-dim = 2
-
-[mesh]
-domain = "rectangle"
-size = [1.0, 0.5]
-cells = [4, 2]
-
-[boundary]
-dirichlet = ["top"]
-contact = ["bottom"]
-
-[material]
-E = 1000.0
-nu = 0.3
-
-[memory]
-kernel = "prony"
-terms = [{ E = 200.0, nu = 0.3, tau = 0.5 }]
-
-[loads]
-body = ["0", "-400*t"]
-
-[contact]
-gap = "0.001 + 0.01*(x - 0.5)**2"
-
-[contact.normal]
-law = "compliance"
-c = 300.0
-
-[time]
-T = 1.0
-steps = 2
-"""
+CONTACT = to_toml(scene_dict({
+    "title": "small block on a compliant wall",
+    "mesh": {"domain": "rectangle", "size": [1.0, 0.5], "cells": [4, 2]},
+    "memory": prony((200.0, 0.3, 0.5)),
+    "loads": {"body": ["0", "-400*t"]},
+    "contact": {"gap": "0.001 + 0.01*(x - 0.5)**2", "normal": law("compliance", c=300.0)},
+    "time.steps": 2,
+}))
 
 GRID = ("--set", "contact.normal.c=1e3,5000", "--set", "solver.max_iter=1,50")
 SETTINGS = [("contact.normal.c", [1e3, 5000.0]), ("solver.max_iter", [1, 50])]
