@@ -36,11 +36,17 @@ from . import plots
 from .postprocess import smallness_record, step_records
 
 
+#: the version of summary.json's layout (docs/outputs.md): raised when a key
+#: changes meaning or goes; new keys do not change it
+SCHEMA = 1
+
+
 def summary(solution):
     """The ``summary.json`` document (a dict of plain JSON types)."""
     problem = solution.problem
     mesh, boundary = problem.mesh, problem.boundary
     return {
+        "schema": SCHEMA,
         "scene": problem.scene.resolved,
         "mesh": {
             "nodes": int(mesh.p.shape[1]),

@@ -27,7 +27,7 @@ NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
              "iterations", "residual", "reactions", "contact_force"}
-SUMMARY_KEYS = {"scene", "mesh", "run", "smallness", "warnings", "timings", "linear", "resources",
+SUMMARY_KEYS = {"schema", "scene", "mesh", "run", "smallness", "warnings", "timings", "linear", "resources",
                 "iterations", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
                   "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",
@@ -108,7 +108,7 @@ def test_npz_has_the_firm_keys_and_shapes(solved):
 def test_summary_has_one_record_per_level(solved):
     _, out, _ = solved
     summary = strict_json(out / "summary.json")
-    assert set(summary) == SUMMARY_KEYS
+    assert set(summary) == SUMMARY_KEYS and summary["schema"] == 1
     assert summary["scene"]["title"] == "test block"
     assert set(summary["smallness"]) == SMALLNESS_KEYS
     assert isinstance(summary["warnings"], list)
