@@ -74,6 +74,20 @@ def prony(*terms):
             "terms": [{"E": E, "nu": nu, "tau": tau} for E, nu, tau in terms]}
 
 
+def wall_block(steps=3):
+    """The 8 × 4 block of the study tests, hanging from its top, pulled down
+    onto a compliant layer (c = 5000) and a wall with a gap smallest in the
+    middle; with one Newton iteration allowed it fails at step 1."""
+    return scene_dict({
+        "title": "test block",
+        "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [8, 4]},
+        "memory": prony((200.0, 0.3, 0.5)),
+        "loads": {"body": ["0", "-400*t"]},
+        "contact": {"gap": "0.002 + 0.01*(x - 1)**2", "normal": law("compliance", c=5000.0)},
+        "time.steps": steps,
+    })
+
+
 def glued_contact(gap=0.05):
     """The [contact] table of the glued strip: adhesive compliance, slip
     weakening and an adhesive spring, Frémond bonding, a wall at ``gap``."""

@@ -17,7 +17,7 @@ import dask
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import law, prony, scene_dict, to_toml
+from conftest import law, prony, scene_dict, to_toml, wall_block
 from distributed import LocalCluster
 
 import adhesive_contact.studies.executors as executors
@@ -26,14 +26,7 @@ from adhesive_contact.studies.sweep import _compute_run, _setup
 
 # the test_sweep block (8x4 cells, 3 steps): c = 5000 with one Newton
 # iteration allowed fails at step 1, so the table has a failed row too
-BLOCK = to_toml(scene_dict({
-    "title": "test block",
-    "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [8, 4]},
-    "memory": prony((200.0, 0.3, 0.5)),
-    "loads": {"body": ["0", "-400*t"]},
-    "contact": {"gap": "0.002 + 0.01*(x - 1)**2", "normal": law("compliance", c=5000.0)},
-    "time.steps": 3,
-}))
+BLOCK = to_toml(wall_block())
 
 # the test_converge block on a compliant wall: a k-study against a fine
 # reference, which is sent to the workers with the context

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import law, prony, scene_dict, to_toml
+from conftest import scene_dict, to_toml, wall_block
 
 import adhesive_contact.studies.sweep as sweep_module
 from adhesive_contact import (
@@ -25,14 +25,7 @@ from adhesive_contact.studies.sweep import split_values, variants, with_value
 
 # an 8x4 block hanging from its top, pulled down onto a wall: with one
 # Newton iteration allowed, the stiff layer (c = 5000) fails at step 1
-SCENE_DICT = scene_dict({
-    "title": "test block",
-    "mesh": {"domain": "rectangle", "size": [2.0, 1.0], "cells": [8, 4]},
-    "memory": prony((200.0, 0.3, 0.5)),
-    "loads": {"body": ["0", "-400*t"]},
-    "contact": {"gap": "0.002 + 0.01*(x - 1)**2", "normal": law("compliance", c=5000.0)},
-    "time.steps": 3,
-})
+SCENE_DICT = wall_block()
 SCENE = to_toml(SCENE_DICT)
 
 GRID = ("--set", "contact.normal.c=1e3,5000", "--set", "solver.max_iter=1,50")
