@@ -75,6 +75,13 @@ class OneLineGroup(click.Group):
         sys.exit(code if isinstance(code, int) else 0)
 
 
+def level_status(level):
+    """The progress bar's note on the last level: its t and Newton iterations."""
+    if level is None:
+        return None
+    return f"t = {level.t:.4g}, {level.iterations} Newton iterations"
+
+
 @contextlib.contextmanager
 def interruptible():
     """A block in which Ctrl-C (SIGINT) asks the run to stop at the end of
@@ -163,10 +170,12 @@ def solve_command(scene, out, force, quiet):
             try:
                 with click.progressbar(length=parsed.steps + 1,
                                        file=io.StringIO() if quiet else sys.stderr,
-                                       label=f"{name}: {parsed.steps} steps") as bar, \
-                        interruptible() as interrupted:
+                                       label=f"{name}: {parsed.steps} steps",
+                                       item_show_func=lambda level: level_status(level)) \
+                        as bar, interruptible() as interrupted:
                     solution = solve(problem, recorder=recorder,
-                                     progress=lambda n, N: bar.update(1) or interrupted())
+                                     progress=lambda n, N: bar.update(1, recorder.last)
+                                     or interrupted())
                 if solution.t.size:   # the levels that converged, partial or not
                     for warning in magnitude_warnings(solution):
                         if not quiet:

@@ -35,7 +35,6 @@ from adhesive_contact.storage import json_number, write_json
 from . import plots
 from .postprocess import smallness_record, step_records
 
-
 #: the version of summary.json's layout (docs/outputs.md): raised when a key
 #: changes meaning or goes; new keys do not change it
 SCHEMA = 1

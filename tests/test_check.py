@@ -49,3 +49,11 @@ def test_quiet_solve_prints_no_warning_but_keeps_them(tmp_path):
     assert quiet.stderr == ""
     warnings = json.loads((out / "summary.json").read_text())["warnings"]
     assert warnings and all(w.split()[0] in loud.stderr for w in warnings)
+
+
+def test_progress_shows_t_and_the_newton_iterations():
+    from types import SimpleNamespace
+
+    from adhesive_contact_cli.main import level_status
+    assert level_status(None) is None
+    assert level_status(SimpleNamespace(t=0.25, iterations=4)) == "t = 0.25, 4 Newton iterations"
