@@ -13,6 +13,7 @@ reach a stated relative residual ‖b − A x‖₂ ≤ tol ‖b‖₂ or raise
 """
 
 import time
+from abc import ABC, abstractmethod
 
 import numpy as np
 import scipy.sparse as sp
@@ -23,7 +24,7 @@ class LinearSolverError(RuntimeError):
     """A factorisation or a solve that failed, with what was reached."""
 
 
-class LinearSolver:
+class LinearSolver(ABC):
     """Base class: built once from A, then ``solve(b)``.
 
     Subclasses implement ``_setup(A)`` (A a CSR matrix with n > 0) and
@@ -62,11 +63,13 @@ class LinearSolver:
             self._setup(sp.csr_matrix(A, dtype=float))
         self.setup_seconds = time.perf_counter() - t0
 
+    @abstractmethod
     def _setup(self, A):
-        raise NotImplementedError
+        """Factorise, or build the hierarchy of, A (CSR, n > 0)."""
 
+    @abstractmethod
     def _solve(self, B):
-        raise NotImplementedError
+        """A⁻¹ B for a float block B of shape (n, m), in the same shape."""
 
     def solve(self, b):
         """x = A⁻¹ b for b of shape (n,) or a block (n, m); x has b's shape."""

@@ -20,6 +20,7 @@ does the rest with :func:`~adhesive_contact.studies.pool.execute`.
 import hashlib
 import json
 import tomllib
+from abc import ABC, abstractmethod
 from pathlib import Path
 
 from ..scene import SceneError
@@ -142,7 +143,7 @@ class RunStore:
         return records
 
 
-class Study:
+class Study(ABC):
     """Base class of a study kept in ``folder`` (see the module docstring).
 
     A subclass sets :attr:`kind` (a name for messages) and :attr:`runs_folder`
@@ -161,13 +162,13 @@ class Study:
 
     # -- what a kind of study defines
 
+    @abstractmethod
     def identity(self):
         """What the study is, as a dict of JSON values (hashed into its identity)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def keys(self):
         """The runs of the study, in order (ints or strs)."""
-        raise NotImplementedError
 
     def record_name(self, key):
         """The file name of run ``key``'s record."""
@@ -177,10 +178,10 @@ class Study:
         """Whether a stored record can be used as the result of run ``key``."""
         return isinstance(record, dict)
 
+    @abstractmethod
     def context(self):
         """(setup, args): each process computing runs calls ``setup(*args)``
         once for its state (the parsed scene, …); both must pickle."""
-        raise NotImplementedError
 
     # -- what every study does
 
