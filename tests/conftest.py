@@ -88,6 +88,18 @@ def wall_block(steps=3):
     })
 
 
+def assert_one_line_error(result, code, needle, alone=True):
+    """A command that ended with exit ``code`` and one ``error: ...`` line
+    containing ``needle``, no traceback; ``alone``: nothing else on stderr
+    (else warnings may come before the error)."""
+    assert result.exit_code == code, (result.stdout, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    errors = [line for line in lines if line.startswith("error: ")]
+    assert len(errors) == 1 and (len(lines) == 1 or not alone), result.stderr
+    assert needle in errors[0], errors[0]
+    assert "Traceback" not in result.stderr + result.stdout
+
+
 def glued_contact(gap=0.05):
     """The [contact] table of the glued strip: adhesive compliance, slip
     weakening and an adhesive spring, Frémond bonding, a wall at ``gap``."""

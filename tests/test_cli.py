@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import DELETE, law, prony, scene_dict, to_toml
+from conftest import DELETE, assert_one_line_error, law, prony, scene_dict, to_toml
 
 from adhesive_contact import build_problem, parse_scene, solve
 
@@ -331,14 +331,6 @@ BAD_SCENES = [
     ("negative gap", {"contact.gap": "0.002 - 0.01*x"}, "contact.gap"),
 ]
 
-
-def assert_one_line_error(result, code, needle):
-    assert result.exit_code == code, (result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: "), lines[0]
-    assert needle in lines[0], lines[0]
-    assert "Traceback" not in result.stderr + result.stdout
 
 
 @pytest.mark.parametrize("changes, key", [case[1:] for case in BAD_SCENES],

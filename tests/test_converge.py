@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import law, prony, scene_dict, to_toml
+from conftest import assert_one_line_error, law, prony, scene_dict, to_toml
 
 import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, parse_scene
@@ -58,13 +58,6 @@ def strict_json(path):
         raise ValueError(f"{name} in {path}")
     return json.loads(path.read_text(), parse_constant=refuse)
 
-
-def assert_one_line_error(result, code, needle):
-    assert result.exit_code == code, (result.stdout, result.stderr)
-    errors = [line for line in result.stderr.splitlines() if line.startswith("error: ")]
-    assert len(errors) == 1, result.stderr
-    assert needle in errors[0], errors[0]
-    assert "Traceback" not in result.stderr + result.stdout
 
 
 def snapshot(folder):
@@ -256,7 +249,7 @@ def test_interrupted_study_computes_only_the_missing_levels(fine_study, tmp_path
 
     monkeypatch.setattr(converge_module, "run_level", fail_on_level_2)
     result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)
-    assert_one_line_error(result, 1, "simulated failure")
+    assert_one_line_error(result, 1, "simulated failure", alone=False)
     assert "level 2" in result.stderr
     assert counting.levels == [0, 1] and counting.reference == 1
     assert sorted(p.name for p in out.iterdir()) == ["levels", "reference.npz", "study.json"]
@@ -298,7 +291,7 @@ def test_another_study_in_the_same_out_exits_2(fine_study, tmp_path, scenes, cha
         args[change[0]] = change[1]
     flat = [item for pair in args.items() for item in pair]
     result = run(scene, *flat, "--out", out)
-    assert_one_line_error(result, 2, "holds a different study")
+    assert_one_line_error(result, 2, "holds a different study", alone=False)
     assert needle in result.stderr
     assert "use another --out or remove it" in result.stderr
     assert snapshot(out) == before
@@ -310,7 +303,7 @@ def test_non_empty_folder_without_a_study_is_left_alone(tmp_path, scenes):
     out.mkdir()
     (out / "notes.txt").write_text("keep me")
     result = run(scenes.exact, "--param", "h", "--levels", 2, "--out", out)
-    assert_one_line_error(result, 2, "--out")
+    assert_one_line_error(result, 2, "--out", alone=False)
     assert snapshot(out) == {"notes.txt": b"keep me"}
 
 
@@ -327,21 +320,21 @@ def test_non_empty_folder_without_a_study_is_left_alone(tmp_path, scenes):
 def test_bad_arguments_exit_2_and_write_nothing(tmp_path, scenes, monkeypatch, args, needle):
     monkeypatch.chdir(tmp_path)
     result = run(scenes.contact, *args, "--out", tmp_path / "out")
-    assert_one_line_error(result, 2, needle)
+    assert_one_line_error(result, 2, needle, alone=False)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_exact_reference_without_exact_table_names_what_is_allowed(tmp_path, scenes):
     result = run(scenes.contact, "--param", "h", "--reference", "exact", "--out",
                  tmp_path / "out")
-    assert_one_line_error(result, 2, "--reference")
+    assert_one_line_error(result, 2, "--reference", alone=False)
     assert "fine" in result.stderr and "[exact]" in result.stderr
     assert not (tmp_path / "out").exists()
 
 
 def test_ref_refinement_with_exact_reference_exits_2(tmp_path, scenes):
     result = run(scenes.exact, "--param", "h", "--ref-h", "1", "--out", tmp_path / "out")
-    assert_one_line_error(result, 2, "--ref-h")
+    assert_one_line_error(result, 2, "--ref-h", alone=False)
     assert not (tmp_path / "out").exists()
 
 
@@ -349,7 +342,7 @@ def test_bad_scene_exits_2_and_writes_nothing(tmp_path):
     scene = tmp_path / "bad.toml"
     scene.write_text(to_toml(scene_dict({"material.nu": 0.7}, CONTACT)))
     result = run(scene, "--param", "h", "--out", tmp_path / "out")
-    assert_one_line_error(result, 2, "nu")
+    assert_one_line_error(result, 2, "nu", alone=False)
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
 
 
@@ -378,14 +371,14 @@ def test_step_failure_exits_1_in_the_reference_and_in_a_worker(fine_study, tmp_p
     out = tmp_path / "out"
     args = (scene, "--param", "k", "--levels", 3, "--jobs", 2, "--out", out)
     result = run(*args)
-    assert_one_line_error(result, 1, "reference run: step 1")
+    assert_one_line_error(result, 1, "reference run: step 1", alone=False)
     assert "did not converge" in result.stderr
     assert sorted(p.name for p in out.iterdir()) == ["levels", "study.json"]
     assert counting.reference == 1
 
     shutil.copy(fine_study.out / "reference.npz", out / "reference.npz")
     result = run(*args)
-    assert_one_line_error(result, 1, "did not converge")
+    assert_one_line_error(result, 1, "did not converge", alone=False)
     error = result.stderr.strip().splitlines()[-1]
     assert error.startswith("error: level ") and "step 1" in error
     failed = int(error.split()[2].rstrip(":"))
@@ -446,7 +439,7 @@ def test_a_study_too_large_for_the_machine_is_refused(tmp_path):
     scene.write_text((Path(__file__).resolve().parents[1] / "studies" / "scenes"
                       / "block.toml").read_text())
     result = run(scene, "--param", "h", "--out", tmp_path / "out")
-    assert_one_line_error(result, 2, "--levels: the fine reference would have about 4.6e+06 dofs")
+    assert_one_line_error(result, 2, "--levels: the fine reference would have about 4.6e+06 dofs", alone=False)
     assert not (tmp_path / "out").exists()
     ok = run(scene, "--param", "k", "--levels", 2, "--out", tmp_path / "k")
     assert ok.exit_code == 0

@@ -17,7 +17,7 @@ import dask
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import law, prony, scene_dict, to_toml, wall_block
+from conftest import assert_one_line_error, law, prony, scene_dict, to_toml, wall_block
 from distributed import LocalCluster
 
 import adhesive_contact.studies.executors as executors
@@ -77,12 +77,6 @@ def runner():
 def run(command, *args):
     return runner().invoke(main, [command, *map(str, args)], catch_exceptions=False)
 
-
-def assert_one_line_error(result, code, needle):
-    assert result.exit_code == code, (result.stdout, result.stderr)
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert needle in lines[0], lines[0]
 
 
 def stable_rows(path):

@@ -11,6 +11,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
+from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 from conftest import DELETE, law, run, scene_dict, to_toml
 
@@ -27,7 +28,6 @@ from adhesive_contact.meshes import build_mesh, read_mesh_file
 from adhesive_contact.meshes.builtin import structured_mesh
 from adhesive_contact.scene import MeshSpec
 from adhesive_contact.verification import prolongation
-from adhesive_contact_cli.main import main
 
 MESHES = Path(__file__).resolve().parents[1] / "studies" / "meshes"
 HALF_DISC = MESHES / "half_disc.msh"

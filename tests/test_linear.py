@@ -4,7 +4,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from adhesive_contact.linear_solvers import AMGSolver, PardisoSolver, SuperLUSolver, pardiso
+from adhesive_contact.linear_solvers import (
+    AMGSolver,
+    PardisoSolver,
+    SuperLUSolver,
+    pardiso,
+)
 from adhesive_contact.scheme.condensed import CondensedOperator
 
 

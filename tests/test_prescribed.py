@@ -3,10 +3,10 @@ held sides, and the relaxation kernel ([memory] kernel = "relaxation")."""
 
 import numpy as np
 import pytest
+from conftest import DELETE, prony, scene_dict
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.reactions import prescribed_history, reaction_sides, reactions
-from conftest import DELETE, prony, scene_dict
 
 L, H = 2.0, 0.5
 E, NU = 1000.0, 0.3

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import scene_dict, to_toml, wall_block
+from conftest import assert_one_line_error, scene_dict, to_toml, wall_block
 
 import adhesive_contact.studies.sweep as sweep_module
 from adhesive_contact import (
@@ -40,13 +40,6 @@ def runner():
 def run(*args):
     return runner().invoke(main, ["sweep", *map(str, args)], catch_exceptions=False)
 
-
-def assert_one_line_error(result, code, needle):
-    assert result.exit_code == code, (result.stdout, result.stderr)
-    errors = [line for line in result.stderr.splitlines() if line.startswith("error: ")]
-    assert len(errors) == 1, result.stderr
-    assert needle in errors[0], errors[0]
-    assert "Traceback" not in result.stderr + result.stdout
 
 
 def read_rows(path):
@@ -192,10 +185,10 @@ def test_another_sweep_in_the_folder_exits_2(grid_sweep, scene_file, tmp_path, c
     before = snapshot(out)
     result = run(scene_file, "--set", "contact.normal.c=1e3,4000", "--set",
                  "solver.max_iter=1,50", "--out", out)
-    assert_one_line_error(result, 2, "holds a different sweep")
+    assert_one_line_error(result, 2, "holds a different sweep", alone=False)
     assert "(set [[" in result.stderr and counting == []
     result = run(scene_file, *GRID, "--zip", "--out", out)
-    assert_one_line_error(result, 2, "mode 'grid' there, 'zip' here")
+    assert_one_line_error(result, 2, "mode 'grid' there, 'zip' here", alone=False)
     assert snapshot(out) == before
 
 
@@ -228,7 +221,7 @@ def test_bad_settings_exit_2_naming_them_before_anything_runs(scene_file, tmp_pa
     args = [item for s in sets for item in ("--set", s)]
     zip_ = ["--zip"] if len(sets) == 2 else []
     result = run(scene_file, *args, *zip_, "--out", tmp_path / "out")
-    assert_one_line_error(result, 2, needle)
+    assert_one_line_error(result, 2, needle, alone=False)
     assert counting == [] and not (tmp_path / "out").exists()
 
 
