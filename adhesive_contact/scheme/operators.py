@@ -8,8 +8,19 @@ enter through the coupling block a_FD, built once per step matrix. Two step matr
 
 - a_n = A + k R(0) for n ≥ 1 (the j = n term of the right rectangle rule
   joins the stiffness), formed Schur complement;
-- A alone at t = 0 (no memory yet). With memory it serves one step, so its
-  Schur complement is applied, not formed, preconditioned by the first.
+- A alone at t = 0 (no memory yet). With memory it serves one step, so it
+  is not factorised when A + k R(0) is close enough to it: with
+  D = a_n − A, the t = 0 problem is solved by the proximal iteration
+
+      u⁽ⁱ⁺¹⁾ = argmin ½ uᵀ a_n u − (b + D u⁽ⁱ⁾)ᵀ u + Φ(u_C),
+
+  whose fixed points are the solutions of the t = 0 problem (a_n u − D u =
+  A u) and which contracts the linear part by ρ(a_n⁻¹ D) ≤
+  max(|Δμ|/(μ + Δμ), |Δκ|/(κ + Δκ)) (κ = λ + 2μ/d the bulk modulus, Δ the
+  tensor of k R(0)): each iteration is one step solve with the stored
+  factorisation (:func:`adhesive_contact.scheme.state.step_solve`). Past
+  ρ = 1/2 A is factorised and its Schur complement applied, not formed,
+  preconditioned by that of a_n.
 """
 
 import time
@@ -33,6 +44,8 @@ class StepOperators:
     support: tuple               # per tensor (a_FD (nF, nD), a_D· (nD, ndofs)), built once
     factor_seconds: float
     schur_seconds: float
+    shift: object = None         # sparse D = a_n − A on the free dofs, when t = 0 iterates
+    contraction: float = 0.0     # the bound on ρ(a_n⁻¹ D) of the module doc
 
     @property
     def linear(self):
@@ -66,12 +79,16 @@ class StepOperators:
         fixed = problem.prescribed.fixed
         support = {}   # (λ, μ) -> (a_FD, a_D·): the coupling and the held rows
 
-        def condensed(lam, mu, approximation=None):
+        def frames(lam, mu):
             A = assembly.stiffness(lam, mu)
-            if R is not None:
-                A = (R.T @ A @ R).tocsr()
+            return (R.T @ A @ R).tocsr() if R is not None else A
+
+        def condensed(lam, mu, approximation=None):
+            A = frames(lam, mu)
             rows = A[fixed]     # the held dofs are not rotated: rows of a_n in Cartesian u
             support[(lam, mu)] = (rows[:, free].T.tocsr(), rows)
+            if approximation is False:   # the coupling alone
+                return None
             A = A[free][:, free]
             if method == "pardiso" and contact.size:   # S and the solve halves in one
                 operator = PartialCondensation(A, contact)
@@ -85,14 +102,21 @@ class StepOperators:
         dlam, dmu = memory.instantaneous(problem.scene.k)
         stepped = (material.lam + dlam, material.mu + dmu)
         step = condensed(*stepped)
-        # with PARDISO the t = 0 operator forms S as cheaply as it applies it
-        approximation = None if isinstance(step, PartialCondensation) else step.S.matrix
-        initial = step if (dlam, dmu) == (0.0, 0.0) else condensed(
-            *elastic, approximation=approximation)
+        initial, shift, rho = step, None, 0.0
+        if (dlam, dmu) != (0.0, 0.0):
+            rho = contraction(elastic, (dlam, dmu), problem.dim)
+            if rho <= 0.5:   # t = 0 by the proximal iteration on a_n's factorisation
+                condensed(*elastic, approximation=False)
+                shift = frames(dlam, dmu)[free][:, free]
+            else:   # with PARDISO the t = 0 operator forms S as cheaply as it applies it
+                approximation = (None if isinstance(step, PartialCondensation)
+                                 else step.S.matrix)
+                initial = condensed(*elastic, approximation=approximation)
         schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
         return cls(rotation=R, free=free, initial=initial, step=step,
                    tensors=(elastic, stepped), support=(support[elastic], support[stepped]),
-                   factor_seconds=time.perf_counter() - t0, schur_seconds=schur)
+                   factor_seconds=time.perf_counter() - t0, schur_seconds=schur,
+                   shift=shift, contraction=rho)
 
     def at(self, n):
         """The condensed step matrix of level n."""
@@ -123,3 +147,13 @@ class StepOperators:
     def from_frames(self, u_frame):
         """Cartesian components u = R ũ of a nodal-frame vector (ndofs,)."""
         return self.rotation @ u_frame if self.rotation is not None else u_frame
+
+
+def contraction(tensor, shift, dim):
+    """max(|Δμ|/(μ + Δμ), |Δκ|/(κ + Δκ)), κ = λ + 2μ/d: a bound on the
+    spectral radius of (A + D)⁻¹ D for the stiffnesses A of ``tensor`` and D
+    of ``shift`` (isotropic (λ, μ) pairs, A + D positive definite), since
+    both split into the same deviatoric and volumetric parts."""
+    (lam, mu), (dlam, dmu) = tensor, shift
+    kappa, dkappa = lam + 2.0 * mu / dim, dlam + 2.0 * dmu / dim
+    return max(abs(dmu) / (mu + dmu), abs(dkappa) / (kappa + dkappa))

@@ -7,14 +7,14 @@ belongs to one run: the built-once :class:`~adhesive_contact.problem.Problem`
 is never changed by a run.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..bonding import FacetRate, advance
 from ..contact_energy import ContactEnergy
 from ..expressions import coordinates
-from ..step_methods import Kink, StepOptions, minimise
+from ..step_methods import MAX_ITERATIONS, Kink, StepOptions, minimise
 
 
 @dataclass
@@ -50,6 +50,9 @@ class Level:
     residual: float
 
 
+NEWTON = ("newton", "newton-plain")   # the methods that converge quadratically
+
+
 class ContactStep:
     """The contact terms Φ of a run's steps and the kinks of its friction
     (:mod:`adhesive_contact.contact_energy`), solved by the scene's step
@@ -67,17 +70,20 @@ class ContactStep:
             tangential = np.arange(problem.columns.size).reshape(nc, d)[:, 1:]
             self.kink = Kink(tangential, np.zeros(nc))
 
-    def minimise(self, S, c, beta, n, z0):
+    def minimise(self, S, c, beta, n, z0, tighter=1.0):
         """The step solve of (4.1) on the contact unknowns with β_n, by
-        ``solver.method``."""
+        ``solver.method``; a Newton method's tolerance times ``tighter``."""
         problem = self.problem
         self.energy.set_bonding(beta)
         if self.kink is not None:
             self.kink.radius = self.energy.node_kink(problem.boundary.point_node,
                                                      problem.boundary.nodes.size)
         solver = problem.scene.solver
+        options = self.options(S)
+        if solver.method in NEWTON:
+            options = replace(options, tol=max(options.tol * tighter, 1e-14))
         return minimise(solver.method, S, c, self.energy, problem.upper_bound(n), z0,
-                        self.options(S), self.kink)
+                        options, self.kink)
 
     def options(self, S):
         """The StepOptions of a step with matrix S: the scene's tolerances and,
@@ -158,25 +164,26 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     :class:`~adhesive_contact.step_methods.StepResult` (None without Γ_C)."""
     history = known.history
     step = operators.at(n)
-    c = step.reduce(b)
     d = problem.dim
     nc = 0 if problem.boundary is None else problem.boundary.nodes.size
     force = np.zeros((nc, d))
     on_wall = np.zeros(nc, dtype=bool)
     stuck = np.zeros(nc, dtype=bool)
-    result, z = None, z0
+    if n == 0 and operators.shift is not None:
+        u_free, z, c, result = proximal_solve(step, operators.shift, contact, n, b, beta, z0,
+                                              operators.contraction)
+    else:
+        u_free, z, c, result = free_solve(step, contact, n, b, beta, z0)
+    if u_free is None:
+        return None, None, None, z0, result
     if contact is not None:
-        result = contact.minimise(step.S, c, beta, n, z0)
-        if not result.success:
-            return None, None, None, z0, result
-        z = result.z
         # the force of Γ_C on the body: its reaction in the frame equations
         force.reshape(-1)[problem.columns] = step.S @ z - c
         on_wall = result.on_wall[problem.normal_columns]
         if contact.kink is not None and problem.friction.has_kink:
             stuck = result.stuck
     u_frame = np.zeros(problem.ndofs)
-    u_frame[operators.free] = step.expand(z, b)
+    u_frame[operators.free] = u_free
     u_frame[problem.prescribed.fixed] = known.prescribed   # held dofs are never rotated
     frame_u = u_frame[problem.boundary.dofs.ravel()] if nc else np.zeros(0)
     u = operators.from_frames(u_frame)
@@ -196,3 +203,52 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
         iterations=0 if result is None else result.nit,
         residual=0.0 if result is None else result.residual)
     return level, u, frame_u, z, result
+
+
+def free_solve(step, contact, n, b, beta, z0, tighter=1.0):
+    """The free dofs of (4.1) with the condensed step matrix ``step`` and
+    the load b: the contact problem on z, then the interior by back
+    substitution. Returns ``(u_free, z, c, result)``, u_free None when the
+    contact solve failed; ``result`` None without Γ_C."""
+    c = step.reduce(b)
+    result, z = None, z0
+    if contact is not None:
+        result = contact.minimise(step.S, c, beta, n, z0, tighter)
+        if not result.success:
+            return None, z0, c, result
+        z = result.z
+    return step.expand(z, b), z, c, result
+
+
+def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13):
+    """The t = 0 problem min ½ uᵀ A u − bᵀ u + Φ(u_C) on the free dofs with the
+    factorisation of a_n = A + D only (:mod:`adhesive_contact.scheme.operators`):
+    u⁽ⁱ⁺¹⁾ solves the step with the load b + D u⁽ⁱ⁾, from u⁽⁰⁾ = 0, until
+    ‖u⁽ⁱ⁺¹⁾ − u⁽ⁱ⁾‖ ≤ rtol ‖u⁽ⁱ⁺¹⁾‖ (the error is then about
+    ρ/(1 − ρ) of that, ρ ≤ ``contraction`` ≤ 1/2). The returned result
+    counts the Newton iterations of all of them; its load c is that of the
+    last, so that S z − c is the contact force of the t = 0 problem
+    (a_n u − D u = A u). Same returns as :func:`free_solve`."""
+    u = np.zeros(b.size)
+    # ρ^i below rtol, with a margin for the contact terms' nonlinearity
+    limit = 10 + int(np.log(rtol) / np.log(max(contraction, 1e-3)))
+    total = 0
+    for _ in range(limit):
+        u_next, z0, c, result = free_solve(step, contact, n, b + shift @ u, beta, z0,
+                                           tighter=1e-2)
+        if result is not None:
+            total += result.nit
+            result.nit = total
+        if u_next is None:
+            return None, z0, c, result
+        done = np.linalg.norm(u_next - u) <= rtol * np.linalg.norm(u_next)
+        u = u_next
+        if done:
+            return u, z0, c, result
+    if result is None:   # linear: the iteration contracts by ρ < 1/2, so this is reached
+        return u, z0, c, result
+    result = replace(result, status=MAX_ITERATIONS, message=(
+        f"the t = 0 iteration on the step matrix did not settle in {limit} step solves "
+        f"(each converged; the contact terms' nonlinearity outweighs the contraction "
+        f"{contraction:.2g}); try a smaller time step"))
+    return None, z0, c, result
