@@ -642,8 +642,8 @@ def _read_boundary(table, dim, named_by_file=False):
     displacement = _read_displacement(table.table("displacement"), dim, named_by_file)
     table.finish()
     if not dirichlet and not displacement:
-        raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0), "
-                         "or [boundary.displacement] must prescribe a side")
+        raise SceneError("boundary.dirichlet", _nothing_holds(contact_sides, dim,
+                                                              named_by_file))
     both = set(dirichlet) & set(contact_sides)
     if both:
         raise SceneError("boundary.contact", f"side {sorted(both)[0]!r} is also Dirichlet; "
@@ -654,6 +654,22 @@ def _read_boundary(table, dim, named_by_file=False):
                              f"{'Dirichlet' if side in dirichlet else 'contact'} side; the "
                              "parts of the boundary must be disjoint")
     return dirichlet, contact_sides, displacement
+
+
+def _nothing_holds(contact_sides, dim, named_by_file):
+    """The message for a body no side holds: the model needs |Γ_D| > 0, and
+    glue (boundary.contact) alone does not hold a body; what to write instead."""
+    free = [s for s in SIDES[dim] if s not in contact_sides]
+    side = "SIDE" if named_by_file or not free else free[0]
+    glue = (f"; the glue of boundary.contact ({', '.join(contact_sides)}) cannot hold it "
+            "alone" if contact_sides else "")
+    held = ", ".join(['"0"'] * (dim - 1) + ['"0.01*t"'])
+    rollers = ", ".join(['"0"'] + ['"free"'] * (dim - 1))
+    return (f"must list at least one side: nothing holds the body{glue} (the model needs "
+            f"|Γ_D| > 0); clamp a side with boundary.dirichlet = [\"{side}\"], or "
+            f"prescribe one in [boundary.displacement], e.g. {side} = [{held}] (\"free\" "
+            f"leaves a component free, as rollers {side} = [{rollers}] do; the held "
+            "components must stop every rigid motion)")
 
 
 def _read_displacement(table, dim, named_by_file):
