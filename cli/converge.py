@@ -38,7 +38,7 @@ from .common import (
     scene_folder,
     study_source,
 )
-from .plots import DPI, plot_title
+from .plots import DPI, Units, plot_title
 from .scheduler import open_executor, scheduler_option
 
 # ---------------------------------------------------------------- the table
@@ -113,8 +113,10 @@ def _slope_one_triangle(ax, xs, ys):
             fontsize="small")
 
 
-def plot_error_vs_size(path, document, title):
-    """Errors against h (or k) log-log, with the fitted slopes in the legend."""
+def figure_error_vs_size(document, title, units=None):
+    """Errors against h (or k) log-log, with the fitted slopes in the legend;
+    ``units`` (:class:`~.plots.Units`) name the unit of h and k."""
+    units = units or Units()
     param = document["param"]
     size = "k" if param == "k" else "h"
     rows = document["levels"]
@@ -134,22 +136,35 @@ def plot_error_vs_size(path, document, title):
     else:
         ax.text(0.5, 0.5, "all errors are zero", transform=ax.transAxes, ha="center")
     ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short axes
-    ax.set_xlabel({"h": "mesh size h", "k": "time step k",
-                   "hk": "mesh size h (time step k halved with h)"}[param])
+    length, time = units.suffix("length"), units.suffix("time")
+    ax.set_xlabel({"h": f"mesh size h{length}", "k": f"time step k{time}",
+                   "hk": f"mesh size h{length} (time step k halved with h)"}[param])
     ax.set_ylabel("error, max over the time grid")
-    _save(fig, ax, path, document, title)
+    _finish(fig, ax, document, title)
+    return fig
 
 
-def _save(fig, ax, path, document, title):
-    """Grid, titles, and the PNG written atomically."""
+def _finish(fig, ax, document, title):
+    """Grid and titles."""
     ax.grid(True, which="both", color="0.9", linewidth=0.6)
     _suptitle(fig, document, title)
-    write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI, bbox_inches="tight"),
-                 binary=True)
-    plt.close(fig)
 
 
-def plot_work_precision(path, document, title):
+def _save(fig, path):
+    """The PNG written atomically; the figure closed."""
+    try:
+        write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI,
+                                                 bbox_inches="tight"), binary=True)
+    finally:
+        plt.close(fig)
+
+
+def plot_error_vs_size(path, document, title, units=None):
+    """``error_vs_h.png`` (or ``error_vs_k.png``): :func:`figure_error_vs_size`."""
+    _save(figure_error_vs_size(document, title, units), path)
+
+
+def figure_work_precision(document, title):
     """E against the wall time of each level's run, log-log."""
     rows = document["levels"]
     info = document["reference"]
@@ -172,14 +187,21 @@ def plot_work_precision(path, document, title):
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("wall time of the level's run (s): assembly and time stepping")
     ax.set_ylabel("error E")
-    _save(fig, ax, path, document, title)
+    _finish(fig, ax, document, title)
+    return fig
 
 
-def write_plots(out, document, title):
-    """Draw the two figures of a study into ``out``; return their names."""
+def plot_work_precision(path, document, title):
+    """``work_precision.png``: :func:`figure_work_precision`."""
+    _save(figure_work_precision(document, title), path)
+
+
+def write_plots(out, document, title, units=None):
+    """Draw the two figures of a study into ``out``; return their names.
+    ``units``: the scene's ``[output] units`` (a dict), naming h's and k's."""
     size = "k" if document["param"] == "k" else "h"
     names = [f"error_vs_{size}.png", "work_precision.png"]
-    plot_error_vs_size(out / names[0], document, title)
+    plot_error_vs_size(out / names[0], document, title, Units(units))
     plot_work_precision(out / names[1], document, title)
     return names
 
@@ -258,7 +280,8 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     bars = Progress(name, study)
     try:
         result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
-        files = result.files + write_plots(out, result.document, study.scene.title)
+        files = result.files + write_plots(out, result.document, study.scene.title,
+                                           study.scene.units)
     except RunFailed as err:
         raise CliError(str(err), 1) from None
     except ClusterError as err:
