@@ -50,16 +50,36 @@ def _fmt(value, spec=".3e", none="—"):
     return format(value, spec)
 
 
+def norms_legend(document):
+    """What the table's columns are (lines printed above it): the norms,
+    over which times, against what, and which h."""
+    against = ("u, β: the scene's exact solution" if document["reference"]["kind"] == "exact"
+               else "u, β: the fine reference run, u_h carried to its mesh (exact nested "
+                    "P1 prolongation) and β_h to its facets")
+    return [
+        "errors, each the max over the time levels t_n of the level "
+        "(docs/verification.md):",
+        "  ‖ε(u−u_h)‖ = ‖ε(u(t_n)) − ε(u_h^n)‖ in L²(Ω);  ‖β−β_h‖ = ‖β(t_n) − β_h^n‖ in "
+        "L²(Γ_C);  E = max of their sum",
+        f"  {against}",
+        "  rel = the error over the same norm of u, β (its max over t_n; for E the sum "
+        "of both);  h = the largest edge length (cell diameter) of the mesh, k = T/N",
+    ]
+
+
 def table(document):
-    """The printed table of levels and the fitted rates (a list of lines)."""
-    header = (f"{'level':>5} {'h':>10} {'k':>10} {'dofs':>8} {'‖ε(u−u_h)‖':>11} "
-              f"{'‖β−β_h‖':>10} {'E':>10} {'rate E':>7} {'seconds':>8}")
-    lines = [header]
+    """The printed table of levels and the fitted rates (a list of lines):
+    :func:`norms_legend`, then per level the absolute and relative errors."""
+    header = (f"{'level':>5} {'h':>9} {'k':>9} {'dofs':>7} {'‖ε(u−u_h)‖':>10} {'rel':>7} "
+              f"{'‖β−β_h‖':>9} {'rel':>7} {'E':>9} {'rel':>7} {'rate E':>6} {'seconds':>7}")
+    lines = norms_legend(document) + [header]
     for row in document["levels"]:
-        lines.append(f"{row['level']:>5} {_fmt(row['h']):>10} {_fmt(row['k']):>10} "
-                     f"{row['dofs']:>8} {_fmt(row['err_u']):>11} {_fmt(row['err_beta']):>10} "
-                     f"{_fmt(row['E']):>10} {_fmt(row['rate_E'], '.2f'):>7} "
-                     f"{_fmt(row['seconds'], '.2f'):>8}")
+        lines.append(f"{row['level']:>5} {_fmt(row['h'], '.2e'):>9} {_fmt(row['k'], '.2e'):>9} "
+                     f"{row['dofs']:>7} {_fmt(row['err_u'], '.3e'):>10} "
+                     f"{_fmt(row.get('rel_u'), '.1e'):>7} "
+                     f"{_fmt(row['err_beta'], '.2e'):>9} {_fmt(row.get('rel_beta'), '.1e'):>7} "
+                     f"{_fmt(row['E'], '.2e'):>9} {_fmt(row.get('rel_E'), '.1e'):>7} "
+                     f"{_fmt(row['rate_E'], '.2f'):>6} {_fmt(row['seconds'], '.2f'):>7}")
     fit = document["rates"]
     size = "k" if document["param"] == "k" else "h"
     n = len(document["levels"])
