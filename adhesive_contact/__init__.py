@@ -4,7 +4,7 @@ long memory, solved with the fully discrete scheme of Cheng & Xiao
 Euler bonding) on scikit-fem. See docs/model.md for the mathematics."""
 
 from .expressions import ExpressionError, compile_expression
-from .io import write_xdmf
+from .io import OutputFolderError, load_solution, write_xdmf
 from .postprocess import STATE_NAMES, contact_state_codes, contact_traction, total_contact_force
 from .problem import Problem, build_problem
 from .reactions import reaction_sides, reactions
@@ -16,4 +16,5 @@ __version__ = "0.1.0"
 __all__ = ["ExpressionError", "compile_expression", "Problem", "build_problem", "Scene",
            "SceneError", "load_scene", "parse_scene", "scene_from_dict", "Solution", "StepFailure",
            "solve", "contact_traction", "total_contact_force", "contact_state_codes",
-           "STATE_NAMES", "reactions", "reaction_sides", "write_xdmf", "__version__"]
+           "STATE_NAMES", "reactions", "reaction_sides", "write_xdmf", "load_solution",
+           "OutputFolderError", "__version__"]

@@ -95,6 +95,8 @@ def run_reference(scene, param, levels, ref_h=None, ref_k=None, progress=None):
 
 
 def _errors_against_reference(problem, solution, reference):
+    """Per level t_n of the level's grid: (e_u, e_β, ‖ε(u_ref)‖, ‖β_ref‖), the
+    norms those of the reference at t_n, all on the reference's mesh."""
     scene = problem.scene
     meshes = nested_meshes(scene.mesh, reference.scene.mesh.refine - scene.mesh.refine)
     fine = meshes[-1]
@@ -107,17 +109,21 @@ def _errors_against_reference(problem, solution, reference):
     if problem.boundary is not None and problem.boundary.facets.size:
         parents = facet_parents(meshes, problem.boundary.facets, reference.facets)
     lengths = _facet_lengths(fine, reference.facets)
-    err_u, err_b = [], []
+    err_u, err_b, norm_u, norm_b = [], [], [], []
     for n in range(scene.steps + 1):
         uf = P @ solution.u[n]                                   # (npoints_f, d)
         du = (uf - reference.u[n * ratio]).ravel()
         err_u.append(strain_error_fine(fine, B, du))
+        norm_u.append(strain_error_fine(fine, B, reference.u[n * ratio].ravel()))
         if parents is None:
             err_b.append(0.0)
+            norm_b.append(0.0)
         else:
-            db = solution.beta[n][parents] - reference.beta[n * ratio]
+            ref_beta = reference.beta[n * ratio]
+            db = solution.beta[n][parents] - ref_beta
             err_b.append(float(np.sqrt(np.sum(lengths * db * db))))
-    return np.array(err_u), np.array(err_b)
+            norm_b.append(float(np.sqrt(np.sum(lengths * ref_beta * ref_beta))))
+    return np.array(err_u), np.array(err_b), np.array(norm_u), np.array(norm_b)
 
 
 def _facet_lengths(mesh, facets):
@@ -127,6 +133,8 @@ def _facet_lengths(mesh, facets):
 
 
 def _errors_against_exact(problem, solution):
+    """Per level t_n: (e_u, e_β, ‖ε(u*)‖, ‖β*‖), each norm with the
+    quadrature of its error (the error of a zero field)."""
     exact = problem.exact
     errors = ExactErrors(problem, exact.strain,
                          exact.beta if problem.boundary is not None else None)
@@ -134,7 +142,19 @@ def _errors_against_exact(problem, solution):
                       for n, t in enumerate(solution.t)])
     err_b = np.array([errors.bonding(solution.beta[n], t)
                       for n, t in enumerate(solution.t)])
-    return err_u, err_b
+    zero_u, zero_b = np.zeros_like(solution.u[0]).ravel(), np.zeros_like(solution.beta[0])
+    norm_u = np.array([errors.strain(zero_u, t) for t in solution.t])
+    norm_b = np.array([errors.bonding(zero_b, t) for t in solution.t])
+    return err_u, err_b, norm_u, norm_b
+
+
+def relative(error, norm):
+    """max_n error(t_n) / max_n norm(t_n): an error relative to the size of
+    the solution over the time grid (NaN when that size is 0). The maxima
+    are taken apart so that a solution that starts at 0 (u(0) = 0) does
+    not divide by 0 at t_0."""
+    size = float(np.max(norm))
+    return float(np.max(error)) / size if size > 0 else float("nan")
 
 
 def run_level(scene, param, level, reference=None, progress=None):
@@ -142,6 +162,14 @@ def run_level(scene, param, level, reference=None, progress=None):
 
     ``reference`` is a :class:`Reference`, or None to use the scene's exact
     solution; ``progress(n, N)`` is called per step.
+
+    Errors, with u, β the exact solution or the reference (docs/verification.md):
+    ``err_u`` = max_n ‖ε(u(t_n)) − ε(u_h^n)‖_{L²(Ω)}, ``err_beta`` =
+    max_n ‖β(t_n) − β_h^n‖_{L²(Γ_C)}, ``E`` = max_n of their sum; and each
+    relative to the same norm of u, β (:func:`relative`): ``rel_u`` =
+    err_u / max_n ‖ε(u(t_n))‖, ``rel_beta`` = err_beta / max_n ‖β(t_n)‖,
+    ``rel_E`` = E / max_n (‖ε(u(t_n))‖ + ‖β(t_n)‖). ``h`` is the largest
+    edge length of the level's mesh (its largest cell diameter), ``k`` = T/N.
     """
     lscene = level_scene(scene, param, level)
     t0 = time.perf_counter()
@@ -151,14 +179,16 @@ def run_level(scene, param, level, reference=None, progress=None):
     if reference is None:
         if problem.exact is None:
             raise ValueError("the scene has no [exact] solution; use a fine reference")
-        err_u, err_b = _errors_against_exact(problem, solution)
+        err_u, err_b, norm_u, norm_b = _errors_against_exact(problem, solution)
     else:
-        err_u, err_b = _errors_against_reference(problem, solution, reference)
+        err_u, err_b, norm_u, norm_b = _errors_against_reference(problem, solution, reference)
     E = err_u + err_b
     return {
         "level": level, "h": mesh_size(problem.mesh), "k": lscene.k,
         "dofs": int(problem.ndofs), "steps": lscene.steps, "refine": lscene.mesh.refine,
         "err_u": float(err_u.max()), "err_beta": float(err_b.max()), "E": float(E.max()),
+        "rel_u": relative(err_u, norm_u), "rel_beta": relative(err_b, norm_b),
+        "rel_E": relative(E, norm_u + norm_b),
         "seconds": seconds, "newton_iterations": int(solution.iterations.sum()),
     }
 

@@ -51,6 +51,10 @@ MAX_NODES = 10**8           # nodes of the refined mesh
 MAX_STEPS = 10**8           # time steps
 TOL_RANGE = (1e-14, 1e-3)   # solver.tol, relative to the force scale of a step
 MAX_ITER = 10_000           # solver.max_iter
+MAX_UNIT = 16               # characters of a unit name in output.units
+
+#: the quantities ``output.units`` may name (labels of the plots only)
+UNIT_KEYS = ("length", "stress", "time", "force")
 
 SIDES = {2: ("left", "right", "bottom", "top"),
          3: ("left", "right", "bottom", "top", "front", "back")}
@@ -236,6 +240,7 @@ class Scene:
     probes: tuple
     exact: ExactSpec = None       # None: no manufactured solution
     displacement: dict = field(default_factory=dict)  # side -> d Expressions or None ("free")
+    units: dict = field(default_factory=dict)  # quantity -> unit name ([output] units)
 
     @property
     def held_sides(self):
@@ -277,7 +282,8 @@ class Scene:
             "contact": _contact_record(self.contact),
             "time": {"T": self.T, "steps": self.steps, "k": self.k},
             "solver": _solver_record(self.solver),
-            "output": {"probes": [list(p) for p in self.probes]},
+            "output": {"probes": [list(p) for p in self.probes],
+                       **({"units": dict(self.units)} if self.units else {})},
             "exact": _exact_record(self.exact),
         }
 
@@ -382,7 +388,8 @@ KNOWN_KEYS = {
     "contact.bonding": {"law", "beta0", "integrator", "gamma_nu", "gamma_tau", "eps_a", "L"},
     "time": {"T", "steps"},
     "solver": {"method", "tol", "max_iter", "linear", "penalty", "smoothing"},
-    "output": {"probes"},
+    "output": {"probes", "units"},
+    "output.units": set(UNIT_KEYS),
     "exact": {"u", "beta", "multiplier"},
 }
 
@@ -642,8 +649,8 @@ def _read_boundary(table, dim, named_by_file=False):
     displacement = _read_displacement(table.table("displacement"), dim, named_by_file)
     table.finish()
     if not dirichlet and not displacement:
-        raise SceneError("boundary.dirichlet", "must list at least one side (|Γ_D| > 0), "
-                         "or [boundary.displacement] must prescribe a side")
+        raise SceneError("boundary.dirichlet", _nothing_holds(contact_sides, dim,
+                                                              named_by_file))
     both = set(dirichlet) & set(contact_sides)
     if both:
         raise SceneError("boundary.contact", f"side {sorted(both)[0]!r} is also Dirichlet; "
@@ -654,6 +661,22 @@ def _read_boundary(table, dim, named_by_file=False):
                              f"{'Dirichlet' if side in dirichlet else 'contact'} side; the "
                              "parts of the boundary must be disjoint")
     return dirichlet, contact_sides, displacement
+
+
+def _nothing_holds(contact_sides, dim, named_by_file):
+    """The message for a body no side holds: the model needs |Γ_D| > 0, and
+    glue (boundary.contact) alone does not hold a body; what to write instead."""
+    free = [s for s in SIDES[dim] if s not in contact_sides]
+    side = "SIDE" if named_by_file or not free else free[0]
+    glue = (f"; the glue of boundary.contact ({', '.join(contact_sides)}) cannot hold it "
+            "alone" if contact_sides else "")
+    held = ", ".join(['"0"'] * (dim - 1) + ['"0.01*t"'])
+    rollers = ", ".join(['"0"'] + ['"free"'] * (dim - 1))
+    return (f"must list at least one side: nothing holds the body{glue} (the model needs "
+            f"|Γ_D| > 0); clamp a side with boundary.dirichlet = [\"{side}\"], or "
+            f"prescribe one in [boundary.displacement], e.g. {side} = [{held}] (\"free\" "
+            f"leaves a component free, as rollers {side} = [{rollers}] do; the held "
+            "components must stop every rigid motion)")
 
 
 def _read_displacement(table, dim, named_by_file):
@@ -929,10 +952,35 @@ def _read_solver(table):
     return SolverSpec(method, tol, max_iter, linear, penalty, smoothing)
 
 
-def _read_probes(table, dim):
-    """The probe points of ``output.probes`` (none without an [output] table)."""
+def _read_output(table, dim):
+    """(probes, units) of the [output] table: none of either without it."""
     if table is None:
-        return ()
+        return (), {}
+    units = _read_units(table.table("units"))
+    return _read_probes(table, dim), units
+
+
+def _read_units(table):
+    """{quantity: unit name} of ``output.units``: names the plots' axes use
+    instead of "units of length" etc.; they change no number."""
+    if table is None:
+        return {}
+    units = {}
+    for name in UNIT_KEYS:
+        if not table.has(name):
+            table.used.add(name)
+            continue
+        value = table.get(name, "str")
+        if not 1 <= len(value) <= MAX_UNIT or not value.isprintable() or value != value.strip():
+            raise SceneError(table.key(name), f"must be a unit name of 1 to {MAX_UNIT} "
+                             f"printable characters without outer spaces, got {_show(value)}")
+        units[name] = value
+    table.finish()
+    return units
+
+
+def _read_probes(table, dim):
+    """The probe points of ``output.probes``."""
     raw = table.get("probes", "list", [], required=False)
     for i, p in enumerate(raw):
         if not (isinstance(p, list) and len(p) == dim and all(
@@ -1013,13 +1061,13 @@ def scene_from_dict(data, base_dir=None):
     contact = _read_contact(top.table("contact"), dim, contact_sides)
     T, steps = _read_time(top.table("time", required=True))
     solver = _read_solver(top.table("solver"))
-    probes = _read_probes(top.table("output"), dim)
+    probes, units = _read_output(top.table("output"), dim)
     exact = _read_exact(top.table("exact"), dim, contact, top.has("loads"))
     top.finish()
     if memory is not None and memory.kernel == "relaxation":
         _check_relaxation_step(memory, dim, T / steps)
     return Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
-                 traction, contact, T, steps, solver, probes, exact, displacement)
+                 traction, contact, T, steps, solver, probes, exact, displacement, units)
 
 
 def parse_scene(text, base_dir=None):

@@ -38,7 +38,7 @@ from .common import (
     scene_folder,
     study_source,
 )
-from .plots import DPI, plot_title
+from .plots import DPI, Units, plot_title
 from .scheduler import open_executor, scheduler_option
 
 # ---------------------------------------------------------------- the table
@@ -50,16 +50,36 @@ def _fmt(value, spec=".3e", none="—"):
     return format(value, spec)
 
 
+def norms_legend(document):
+    """What the table's columns are (lines printed above it): the norms,
+    over which times, against what, and which h."""
+    against = ("u, β: the scene's exact solution" if document["reference"]["kind"] == "exact"
+               else "u, β: the fine reference run, u_h carried to its mesh (exact nested "
+                    "P1 prolongation) and β_h to its facets")
+    return [
+        "errors, each the max over the time levels t_n of the level "
+        "(docs/verification.md):",
+        "  ‖ε(u−u_h)‖ = ‖ε(u(t_n)) − ε(u_h^n)‖ in L²(Ω);  ‖β−β_h‖ = ‖β(t_n) − β_h^n‖ in "
+        "L²(Γ_C);  E = max of their sum",
+        f"  {against}",
+        "  rel = the error over the same norm of u, β (its max over t_n; for E the sum "
+        "of both);  h = the largest edge length (cell diameter) of the mesh, k = T/N",
+    ]
+
+
 def table(document):
-    """The printed table of levels and the fitted rates (a list of lines)."""
-    header = (f"{'level':>5} {'h':>10} {'k':>10} {'dofs':>8} {'‖ε(u−u_h)‖':>11} "
-              f"{'‖β−β_h‖':>10} {'E':>10} {'rate E':>7} {'seconds':>8}")
-    lines = [header]
+    """The printed table of levels and the fitted rates (a list of lines):
+    :func:`norms_legend`, then per level the absolute and relative errors."""
+    header = (f"{'level':>5} {'h':>9} {'k':>9} {'dofs':>7} {'‖ε(u−u_h)‖':>10} {'rel':>7} "
+              f"{'‖β−β_h‖':>9} {'rel':>7} {'E':>9} {'rel':>7} {'rate E':>6} {'seconds':>7}")
+    lines = norms_legend(document) + [header]
     for row in document["levels"]:
-        lines.append(f"{row['level']:>5} {_fmt(row['h']):>10} {_fmt(row['k']):>10} "
-                     f"{row['dofs']:>8} {_fmt(row['err_u']):>11} {_fmt(row['err_beta']):>10} "
-                     f"{_fmt(row['E']):>10} {_fmt(row['rate_E'], '.2f'):>7} "
-                     f"{_fmt(row['seconds'], '.2f'):>8}")
+        lines.append(f"{row['level']:>5} {_fmt(row['h'], '.2e'):>9} {_fmt(row['k'], '.2e'):>9} "
+                     f"{row['dofs']:>7} {_fmt(row['err_u'], '.3e'):>10} "
+                     f"{_fmt(row.get('rel_u'), '.1e'):>7} "
+                     f"{_fmt(row['err_beta'], '.2e'):>9} {_fmt(row.get('rel_beta'), '.1e'):>7} "
+                     f"{_fmt(row['E'], '.2e'):>9} {_fmt(row.get('rel_E'), '.1e'):>7} "
+                     f"{_fmt(row['rate_E'], '.2f'):>6} {_fmt(row['seconds'], '.2f'):>7}")
     fit = document["rates"]
     size = "k" if document["param"] == "k" else "h"
     n = len(document["levels"])
@@ -113,8 +133,10 @@ def _slope_one_triangle(ax, xs, ys):
             fontsize="small")
 
 
-def plot_error_vs_size(path, document, title):
-    """Errors against h (or k) log-log, with the fitted slopes in the legend."""
+def figure_error_vs_size(document, title, units=None):
+    """Errors against h (or k) log-log, with the fitted slopes in the legend;
+    ``units`` (:class:`~.plots.Units`) name the unit of h and k."""
+    units = units or Units()
     param = document["param"]
     size = "k" if param == "k" else "h"
     rows = document["levels"]
@@ -134,22 +156,35 @@ def plot_error_vs_size(path, document, title):
     else:
         ax.text(0.5, 0.5, "all errors are zero", transform=ax.transAxes, ha="center")
     ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short axes
-    ax.set_xlabel({"h": "mesh size h", "k": "time step k",
-                   "hk": "mesh size h (time step k halved with h)"}[param])
+    length, time = units.suffix("length"), units.suffix("time")
+    ax.set_xlabel({"h": f"mesh size h{length}", "k": f"time step k{time}",
+                   "hk": f"mesh size h{length} (time step k halved with h)"}[param])
     ax.set_ylabel("error, max over the time grid")
-    _save(fig, ax, path, document, title)
+    _finish(fig, ax, document, title)
+    return fig
 
 
-def _save(fig, ax, path, document, title):
-    """Grid, titles, and the PNG written atomically."""
+def _finish(fig, ax, document, title):
+    """Grid and titles."""
     ax.grid(True, which="both", color="0.9", linewidth=0.6)
     _suptitle(fig, document, title)
-    write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI, bbox_inches="tight"),
-                 binary=True)
-    plt.close(fig)
 
 
-def plot_work_precision(path, document, title):
+def _save(fig, path):
+    """The PNG written atomically; the figure closed."""
+    try:
+        write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI,
+                                                 bbox_inches="tight"), binary=True)
+    finally:
+        plt.close(fig)
+
+
+def plot_error_vs_size(path, document, title, units=None):
+    """``error_vs_h.png`` (or ``error_vs_k.png``): :func:`figure_error_vs_size`."""
+    _save(figure_error_vs_size(document, title, units), path)
+
+
+def figure_work_precision(document, title):
     """E against the wall time of each level's run, log-log."""
     rows = document["levels"]
     info = document["reference"]
@@ -172,14 +207,21 @@ def plot_work_precision(path, document, title):
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("wall time of the level's run (s): assembly and time stepping")
     ax.set_ylabel("error E")
-    _save(fig, ax, path, document, title)
+    _finish(fig, ax, document, title)
+    return fig
 
 
-def write_plots(out, document, title):
-    """Draw the two figures of a study into ``out``; return their names."""
+def plot_work_precision(path, document, title):
+    """``work_precision.png``: :func:`figure_work_precision`."""
+    _save(figure_work_precision(document, title), path)
+
+
+def write_plots(out, document, title, units=None):
+    """Draw the two figures of a study into ``out``; return their names.
+    ``units``: the scene's ``[output] units`` (a dict), naming h's and k's."""
     size = "k" if document["param"] == "k" else "h"
     names = [f"error_vs_{size}.png", "work_precision.png"]
-    plot_error_vs_size(out / names[0], document, title)
+    plot_error_vs_size(out / names[0], document, title, Units(units))
     plot_work_precision(out / names[1], document, title)
     return names
 
@@ -258,7 +300,8 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     bars = Progress(name, study)
     try:
         result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
-        files = result.files + write_plots(out, result.document, study.scene.title)
+        files = result.files + write_plots(out, result.document, study.scene.title,
+                                           study.scene.units)
     except RunFailed as err:
         raise CliError(str(err), 1) from None
     except ClusterError as err:

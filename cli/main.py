@@ -162,6 +162,8 @@ def solve_command(scene, out, force, quiet):
     check_out(out)
     if not quiet:
         echo_warnings(problem)
+    base = scene_folder(scene)   # summary.json keeps the scene to rebuild the problem from
+    source = {"text": text, "folder": None if base is None else str(base.resolve())}
 
     files, failures = [], []
     try:
@@ -180,7 +182,7 @@ def solve_command(scene, out, force, quiet):
                     for warning in magnitude_warnings(solution):
                         if not quiet:
                             click.echo(f"warning: {warning}", err=True)
-                    files = write_results(solution, folder, failures)
+                    files = write_results(solution, folder, failures, source)
             finally:
                 recorder.close()
             files = sorted(files + recorder.names) if files else []

@@ -40,13 +40,19 @@ from .postprocess import smallness_record, step_records
 SCHEMA = 1
 
 
-def summary(solution):
-    """The ``summary.json`` document (a dict of plain JSON types)."""
+def summary(solution, source=None):
+    """The ``summary.json`` document (a dict of plain JSON types).
+
+    ``source``: ``{"text", "folder"}``, the scene's TOML text and the
+    absolute folder its relative paths are taken in (None: the working
+    directory), from which :func:`adhesive_contact.io.load_solution`
+    rebuilds the problem."""
     problem = solution.problem
     mesh, boundary = problem.mesh, problem.boundary
     return {
         "schema": SCHEMA,
         "scene": problem.scene.resolved,
+        **({"source": source} if source is not None else {}),
         "mesh": {
             "nodes": int(mesh.p.shape[1]),
             "cells": int(mesh.t.shape[1]),
@@ -98,9 +104,9 @@ def run_record(solution):
     }
 
 
-def write_summary(solution, path):
+def write_summary(solution, path, source=None):
     """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
-    write_json(path, summary(solution))
+    write_json(path, summary(solution, source))
 
 
 #: every file name ``adhcontact solve`` may write; in an existing folder a
@@ -190,20 +196,22 @@ def staged_output(out):
         raise
 
 
-def write_results(solution, folder, failures=None):
+def write_results(solution, folder, failures=None, source=None):
     """Write summary.json, solution.npz and the plots of a solution into
     ``folder`` (the XDMF series are the recorder's); return their names. A
     plot that cannot be drawn is left out and named in ``failures`` (a
-    list), if given; the data files are written all the same."""
+    list), if given; the data files are written all the same. ``source``:
+    the scene's text and folder (:func:`summary`)."""
     folder = Path(folder)
-    write_summary(solution, folder / "summary.json")
+    write_summary(solution, folder / "summary.json", source)
     write_npz(solution, folder / "solution.npz")
     return ["summary.json", "solution.npz"] + plots.write_plots(solution, folder, failures)
 
 
-def write_outputs(solution, out, failures=None):
+def write_outputs(solution, out, failures=None, source=None):
     """Write all outputs of a finished in-memory solution into ``out``,
     atomically; return the names of the files written."""
     with staged_output(out) as tmp:
-        names = sorted(write_xdmf(solution, tmp) + write_results(solution, tmp, failures))
+        names = sorted(write_xdmf(solution, tmp)
+                       + write_results(solution, tmp, failures, source))
     return names

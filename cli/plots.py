@@ -5,10 +5,13 @@ contact boundary, ``contact_traction.png`` and ``beta.png`` (and in 3D
 ``contact_map.png``: β, the normal traction and the slip over Γ_C); and
 ``load_displacement.png`` when a side is moved or loaded (the reaction of a
 side against its prescribed displacement, the applied force of a loaded
-side against its mean displacement). The scene
-carries no units, so axes are labelled in the scene's units (lengths as in
-``mesh.size``, stresses as in ``material.E``). Matplotlib runs on the Agg
-backend (no display needed).
+side against its mean displacement). The axes name the units of the
+scene's ``[output] units`` (:class:`Units`); a scene without them is
+labelled in its own units ("units of length" as in ``mesh.size``, "units
+of E" for stresses as in ``material.E``). Each ``figure_*`` function
+returns the matplotlib figure (tests read its labels), each ``plot_*``
+draws it into a PNG. Matplotlib runs on the Agg backend (no display
+needed).
 """
 
 import matplotlib
@@ -18,6 +21,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 
 from adhesive_contact.postprocess import (  # noqa: E402
@@ -106,7 +110,77 @@ def _title(solution):
     return plot_title(solution.problem.scene.title)
 
 
-def _deformed_2d(fig, ax, solution, factor):
+class Units:
+    """How the axes name a scene's units (``[output] units``, docs/scenes.md).
+
+    ``length`` and ``stress`` are the unit names given, or "units of
+    length" and "units of E" (the wording for a scene without units);
+    :meth:`suffix` is " (unit)" for a quantity whose unit is given, else "".
+    Names are escaped for matplotlib (a ``$`` would start mathtext).
+    """
+
+    def __init__(self, given=None):
+        self.given = {key: value.replace("$", r"\$") for key, value in (given or {}).items()}
+
+    @classmethod
+    def of(cls, solution):
+        """The units of the scene a solution solved."""
+        return cls(solution.problem.scene.units)
+
+    @property
+    def length(self):
+        return self.given.get("length", "units of length")
+
+    @property
+    def stress(self):
+        return self.given.get("stress", "units of E")
+
+    def suffix(self, quantity):
+        """" (unit)" when ``quantity``'s unit is given, else ""."""
+        unit = self.given.get(quantity)
+        return f" ({unit})" if unit else ""
+
+    @property
+    def time(self):
+        """The label of the time axis."""
+        return "time t" + self.suffix("time")
+
+    def force(self, dim):
+        """The label of a total force on the body (per unit thickness in 2D)."""
+        force, length = self.given.get("force"), self.given.get("length")
+        if dim == 3:
+            return "force on the body" + self.suffix("force")
+        if force is None:
+            return "force on the body (per unit thickness in 2D)"
+        per = f"{force}/{length}" if length else f"{force} per unit thickness"
+        return f"force on the body per unit thickness ({per})"
+
+
+def tidy_3d_axes(ax, nbins=4):
+    """Fewer, smaller ticks on the three axes of a 3D plot (their labels
+    overlap otherwise) and short axis names x, y, z (the unit of length goes
+    into the title: longer names run into each other)."""
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(nbins=nbins))
+    ax.tick_params(labelsize="small", pad=1)
+    ax.set_xlabel("x", labelpad=4)
+    ax.set_ylabel("y", labelpad=4)
+    ax.set_zlabel("z", labelpad=4)
+
+
+def save_figure(fig, path):
+    """Write a figure as a PNG and close it."""
+    try:
+        fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    finally:
+        plt.close(fig)
+
+
+#: the von Mises stress of the colour bars: of the whole 3 × 3 stress
+VON_MISES = "von Mises stress"
+
+
+def _deformed_2d(fig, ax, solution, factor, units):
     mesh = solution.problem.mesh
     p = mesh.p + factor * solution.u[-1].T
     vm = cell_von_mises(solution, -1)
@@ -122,15 +196,15 @@ def _deformed_2d(fig, ax, solution, factor):
         ax.plot(p[0, on], p[1, on], "o", color="tab:red", markersize=3,
                 label="contact nodes on the wall")
     ax.set_aspect("equal")
-    ax.set_xlabel("x (units of length)")
-    ax.set_ylabel("y (units of length)")
+    ax.set_xlabel(f"x ({units.length})")
+    ax.set_ylabel(f"y ({units.length})")
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")
     # below the axes: a colorbar as wide as a flat domain, never taller than it
     fig.colorbar(image, ax=ax, location="bottom", shrink=0.7, pad=0.14, aspect=35,
-                 label="von Mises stress (in-plane σ; units of E)")
+                 label=f"{VON_MISES} (plane strain: σ_zz included; {units.stress})")
 
 
-def _deformed_3d(fig, solution, factor):
+def _deformed_3d(fig, solution, factor, units):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     mesh = solution.problem.mesh
@@ -143,30 +217,38 @@ def _deformed_3d(fig, solution, factor):
     ax.add_collection3d(Poly3DCollection(polys, facecolors=plt.cm.viridis(norm(vm)),
                                          edgecolors="k", linewidths=0.1))
     low, high = p.min(axis=1), p.max(axis=1)
-    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]),
-           xlabel="x", ylabel="y", zlabel="z")
+    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+    tidy_3d_axes(ax)
     ax.set_box_aspect(high - low)
     mappable = plt.cm.ScalarMappable(norm=norm, cmap="viridis")
-    fig.colorbar(mappable, ax=ax, shrink=0.7, label="von Mises stress (units of E)")
+    fig.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12,
+                 label=f"{VON_MISES} ({units.stress})")
     return ax
 
 
-def plot_deformed(solution, path):
-    """The deformed mesh at the final time, coloured by von Mises stress."""
+def figure_deformed(solution):
+    """The deformed mesh at the final time, coloured by the von Mises stress
+    of σ (in 2D with the plane-strain σ_zz)."""
     mesh = solution.problem.mesh
+    units = Units.of(solution)
     factor = magnification(mesh.p, solution.u[-1])
     fig = plt.figure(figsize=(9, 5))
     if mesh.dim() == 2:
         ax = fig.add_subplot()
-        _deformed_2d(fig, ax, solution, factor)
+        _deformed_2d(fig, ax, solution, factor, units)
     else:
-        ax = _deformed_3d(fig, solution, factor)
+        ax = _deformed_3d(fig, solution, factor, units)
     scale = ("displacements to scale" if factor == 1.0 else
              f"displacements magnified ×{factor:g}")
-    ax.set_title(f"{_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, {scale}",
-                 fontsize="medium")
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
+    coordinates = f"; x, y, z in {units.length}" if mesh.dim() == 3 else ""
+    ax.set_title(f"{_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, {scale}"
+                 f"{coordinates}", fontsize="medium")
+    return fig
+
+
+def plot_deformed(solution, path):
+    """``deformed.png``: :func:`figure_deformed`."""
+    save_figure(figure_deformed(solution), path)
 
 
 def _tangent_label(problem):
@@ -181,7 +263,7 @@ def _tangent_label(problem):
     return "along τ = (" + ", ".join(f"{c:.2g}" for c in tau) + ")"
 
 
-def plot_contact_traction(solution, path):
+def figure_contact_traction(solution):
     """Normal and tangential traction and the normal displacement along Γ_C.
 
     Three panels sharing the coordinate along Γ_C, one curve per sampled
@@ -191,6 +273,7 @@ def plot_contact_traction(solution, path):
     and u_ν with the gap. Nodes on the wall are ringed; with a friction kink
     stuck nodes are marked by squares on the tangential panel."""
     problem = solution.problem
+    units = Units.of(solution)
     boundary = problem.boundary
     x_nodes = problem.mesh.p[:, boundary.nodes]
     axis = along_axis(x_nodes)
@@ -226,16 +309,16 @@ def plot_contact_traction(solution, path):
     for ax in (top, middle, bottom):
         ax.axhline(0.0, color="0.6", linewidth=0.8)
         ax.grid(True, color="0.9", linewidth=0.6)
-    top.set_ylabel("normal traction −σ_ν\n(> 0 compression, < 0 tension;\nunits of E)")
+    top.set_ylabel(f"normal traction −σ_ν\n(> 0 compression, < 0 tension;\n{units.stress})")
     what = "contact traction and gap" if gap is not None else "contact traction"
     top.set_title(f"{_title(solution)}\n{what} along Γ_C", fontsize="medium")
     top.legend(title="time level", fontsize="small", loc="upper left",
                bbox_to_anchor=(1.01, 1.0))
     if problem.dim == 2:
         middle.set_ylabel(f"tangential traction σ_τ\n({_tangent_label(problem)};\n"
-                          "units of E)")
+                          f"{units.stress})")
     else:
-        middle.set_ylabel("tangential traction |σ_τ|\n(units of E)")
+        middle.set_ylabel(f"tangential traction |σ_τ|\n({units.stress})")
     if problem.friction is None:
         middle.set_title("no friction law: σ_τ = 0", fontsize="small")
     if kinked:
@@ -248,12 +331,16 @@ def plot_contact_traction(solution, path):
         bottom.plot([], [], "o", color="k", mfc="none", label="node on the wall\n(u_ν = g)")
     if gap is not None:
         _clip_gap_axis(bottom, un, gap)
-    bottom.set_ylabel("normal displacement u_ν\n(> 0 towards the\nfoundation; units of length)")
-    bottom.set_xlabel(f"{AXES[axis]} along Γ_C (units of length)")
+    bottom.set_ylabel(f"normal displacement u_ν\n(> 0 towards the\nfoundation; {units.length})")
+    bottom.set_xlabel(f"{AXES[axis]} along Γ_C ({units.length})")
     bottom.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.align_ylabels((top, middle, bottom))
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
+    return fig
+
+
+def plot_contact_traction(solution, path):
+    """``contact_traction.png``: :func:`figure_contact_traction`."""
+    save_figure(figure_contact_traction(solution), path)
 
 
 def _clip_gap_axis(ax, un, gap):
@@ -279,7 +366,7 @@ def _time_edges(t):
     return np.concatenate([[2 * t[0] - mid[0]], mid, [2 * t[-1] - mid[-1]]])
 
 
-def beta_space_time(problem, beta):
+def beta_space_time(problem, beta, length="units of length"):
     """β on a space-time grid: (x edges, β image (N+1, nx), x label).
 
     2D: one column per contact facet, the facets ordered along the axis of
@@ -287,7 +374,8 @@ def beta_space_time(problem, beta):
     tile a segment (a straight side), else equal widths of the facet
     measures laid end to end (arc length in that order). 3D: the facets are
     binned by their midpoint along that axis and β is the measure-weighted
-    mean over each bin (an average across the width of Γ_C)."""
+    mean over each bin (an average across the width of Γ_C). ``length``
+    names the unit of length in the label."""
     boundary = problem.boundary
     mid = facet_midpoints(problem)
     axis = along_axis(mid)
@@ -298,10 +386,10 @@ def beta_space_time(problem, beta):
         lo, hi = ends.min(axis=0)[order], ends.max(axis=0)[order]
         if np.allclose(hi[:-1], lo[1:]):
             edges = np.concatenate([lo[:1], hi])
-            return edges, beta[:, order], f"{name} along Γ_C (units of length)"
+            return edges, beta[:, order], f"{name} along Γ_C ({length})"
         edges = np.concatenate([[0.0], np.cumsum(boundary.measure[order])])
         return edges, beta[:, order], (f"arc length along Γ_C, facets ordered by {name} "
-                                       "(units of length)")
+                                       f"({length})")
     lo, hi = ends.min(), ends.max()
     nbins = int(np.clip(round(np.sqrt(mid.shape[1])), 1, 60))
     edges = np.linspace(lo, hi, nbins + 1)
@@ -311,11 +399,17 @@ def beta_space_time(problem, beta):
     for n in range(beta.shape[0]):
         sums = np.bincount(which, boundary.measure * beta[n], minlength=nbins)
         image[n, weight > 0] = sums[weight > 0] / weight[weight > 0]
-    return edges, np.ma.masked_invalid(image), (f"{name} of the facet midpoint (units of "
-                                                "length); β averaged across Γ_C")
+    return edges, np.ma.masked_invalid(image), (f"{name} of the facet midpoint ({length}); "
+                                                "β averaged across Γ_C")
 
 
-def plot_beta(solution, path):
+def mean_label(dim):
+    """What beta_mean is: the mean of β over Γ_C weighted by each facet's
+    length (2D) or area (3D), Σ_f |f| β_f / Σ_f |f|."""
+    return f"mean over Γ_C (weighted by facet {'length' if dim == 2 else 'area'})"
+
+
+def figure_beta(solution):
     """β along Γ_C: curves at a few levels, a space-time image, mean and min in time.
 
     Left column (sharing the coordinate along Γ_C): β per facet at a few
@@ -323,6 +417,7 @@ def plot_beta(solution, path):
     colour β in [0, 1]) with the β = 1/2 contour when debonding reaches it.
     Right column: the facet-measure weighted mean and the min of β in time."""
     problem = solution.problem
+    units = Units.of(solution)
     mid = facet_midpoints(problem)
     axis = along_axis(mid)
     order = np.argsort(mid[axis], kind="stable")
@@ -337,11 +432,12 @@ def plot_beta(solution, path):
     image_ax = fig.add_subplot(grid[1, 0])
     bar_ax = fig.add_subplot(grid[1, 1])
     history = fig.add_subplot(grid[:, 3])
-    edges, image, xlabel = beta_space_time(problem, solution.beta)
+    edges, image, xlabel = beta_space_time(problem, solution.beta, units.length)
     tiled = problem.dim == 2 and "arc length" not in xlabel   # edges are coordinates
     for n, colour in zip(levels, colours):
         if tiled:
-            curves.stairs(image[n], edges, color=colour, linewidth=1.5,
+            # baseline None: no vertical lines down to 0 at the two ends
+            curves.stairs(image[n], edges, baseline=None, color=colour, linewidth=1.5,
                           label=f"t = {solution.t[n]:.4g}")
         elif problem.dim == 2:
             curves.plot(x, solution.beta[n, order], drawstyle="steps-mid", color=colour,
@@ -350,8 +446,8 @@ def plot_beta(solution, path):
             curves.plot(x, solution.beta[n, order], ".", color=colour,
                         label=f"t = {solution.t[n]:.4g}")
     curves.set(ylabel="bonding β\n(1 = fully bonded, 0 = debonded)", ylim=(-0.05, 1.05))
-    curves.set_xlabel(f"{AXES[axis]} along Γ_C (units of length)" if tiled else
-                      f"{AXES[axis]} of the facet midpoint (units of length)")
+    curves.set_xlabel(f"{AXES[axis]} along Γ_C ({units.length})" if tiled else
+                      f"{AXES[axis]} of the facet midpoint ({units.length})")
     curves.set_title("β per contact facet at a few time levels", fontsize="medium")
     curves.legend(fontsize="small", title="time level", loc="lower left")
     curves.grid(True, color="0.9", linewidth=0.6)
@@ -368,15 +464,15 @@ def plot_beta(solution, path):
         front = image_ax.contour(centres, solution.t, data, levels=[0.5], colors="w",
                                  linewidths=1.2)
         image_ax.clabel(front, fmt="β = 1/2", fontsize="small")
-    image_ax.set(xlabel=xlabel, ylabel="time t", ylim=(t_edges[0], t_edges[-1]))
+    image_ax.set(xlabel=xlabel, ylabel=units.time, ylim=(t_edges[0], t_edges[-1]))
     image_ax.set_title("β(x, t) on Γ_C (one row per time level)", fontsize="medium")
     fig.colorbar(mesh, cax=bar_ax, label="bonding β")
 
-    history.plot(solution.t, beta_mean(solution), "-", label="mean (weighted by |f|)")
+    history.plot(solution.t, beta_mean(solution), "-", label=mean_label(problem.dim))
     history.plot(solution.t, solution.beta.min(axis=1), "--", label="min over Γ_C")
     history.plot(solution.t, solution.beta.max(axis=1), ":", color="0.5",
                  label="max over Γ_C")
-    history.set(xlabel="time t", ylabel="bonding β", ylim=(-0.05, 1.05))
+    history.set(xlabel=units.time, ylabel="bonding β", ylim=(-0.05, 1.05))
     history.yaxis.set_label_position("right")
     history.yaxis.tick_right()
     history.set_title("β over Γ_C in time", fontsize="medium")
@@ -385,8 +481,12 @@ def plot_beta(solution, path):
     bonding = problem.scene.contact.bonding.law
     frozen = " (bonding law 'none': β frozen at β_0)" if bonding == "none" else ""
     fig.suptitle(f"{_title(solution)}{frozen}\nbonding β along Γ_C", fontsize="medium")
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
+    return fig
+
+
+def plot_beta(solution, path):
+    """``beta.png``: :func:`figure_beta`."""
+    save_figure(figure_beta(solution), path)
 
 
 def plane_coordinates(points, tol=1e-9):
@@ -421,7 +521,7 @@ def facet_values_of_nodes(problem, nodal):
     return np.where(count > 0, values.sum(axis=0) / np.maximum(count, 1), np.nan)
 
 
-def plot_contact_map(solution, path):
+def figure_contact_map(solution):
     """3D: β, the normal traction and the slip over Γ_C at the final time.
 
     Three colour maps, one value per contact facet: β (its P0 value), the
@@ -431,14 +531,15 @@ def plot_contact_map(solution, path):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     problem = solution.problem
+    units = Units.of(solution)
     boundary = problem.boundary
     mesh = problem.mesh
     n = solution.t.size - 1
     fields = [
         ("bonding β", solution.beta[n], "viridis", (0.0, 1.0)),
-        ("normal traction −σ_ν\n(> 0 compression; units of E)",
+        (f"normal traction −σ_ν\n(> 0 compression; {units.stress})",
          facet_values_of_nodes(problem, normal_traction(solution)[n]), "coolwarm", None),
-        ("slip |u_τ| (units of length)",
+        (f"slip |u_τ| ({units.length})",
          facet_values_of_nodes(problem, np.linalg.norm(
              solution.frame_displacement[n, :, 1:], axis=1)), "magma", None),
     ]
@@ -463,8 +564,8 @@ def plot_contact_map(solution, path):
             image = ax.tripcolor(tri, facecolors=np.nan_to_num(values, nan=limits[0]),
                                  cmap=cmap, norm=norm, shading="flat")
             ax.triplot(tri, color="k", linewidth=0.15, alpha=0.3)
-            ax.set(aspect="equal", xlabel=f"{names[0]} (units of length)",
-                   ylabel=f"{names[1]} (units of length)")
+            ax.set(aspect="equal", xlabel=f"{names[0]} ({units.length})",
+                   ylabel=f"{names[1]} ({units.length})")
         else:
             ax = fig.add_subplot(1, 3, i + 1, projection="3d")
             polys = mesh.p[:, boundary.facet_nodes].transpose(2, 1, 0)
@@ -472,16 +573,21 @@ def plot_contact_map(solution, path):
             ax.add_collection3d(Poly3DCollection(polys, facecolors=colours, edgecolors="k",
                                                  linewidths=0.05))
             low, high = mesh.p[:, used].min(axis=1), mesh.p[:, used].max(axis=1)
-            ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]),
-                   xlabel="x", ylabel="y", zlabel="z")
+            ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+            tidy_3d_axes(ax, nbins=3)   # three small panels side by side
             ax.set_box_aspect(np.maximum(high - low, 1e-3 * (high - low).max()))
             image = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
         fig.colorbar(image, ax=ax, shrink=0.8, location="bottom", pad=0.15, label=label)
-    shape = "Γ_C flattened (a plane)" if flat is not None else "Γ_C in 3D (curved)"
+    shape = ("Γ_C flattened (a plane)" if flat is not None else
+             f"Γ_C in 3D (curved; x, y, z in {units.length})")
     fig.suptitle(f"{_title(solution)}\non {shape} at t = {solution.t[n]:g}",
                  fontsize="medium")
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
+    return fig
+
+
+def plot_contact_map(solution, path):
+    """``contact_map.png``: :func:`figure_contact_map`."""
+    save_figure(figure_contact_map(solution), path)
 
 
 def load_curves(solution):
@@ -510,20 +616,25 @@ def load_curves(solution):
     return curves
 
 
-def plot_load_displacement(solution, path, curves=None):
+def figure_load_displacement(solution, curves=None):
     """Force against displacement of the moved or loaded sides, one curve each."""
+    units = Units.of(solution)
     curves = load_curves(solution) if curves is None else curves
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for label, u, force in curves:
         ax.plot(u, force, marker=".", markersize=3, label=label)
     ax.axhline(0.0, color="0.7", linewidth=0.8)
-    ax.set_xlabel("displacement")
-    ax.set_ylabel("force on the body (per unit thickness in 2D)")
+    ax.set_xlabel("displacement" + units.suffix("length"))
+    ax.set_ylabel(units.force(solution.problem.dim))
     ax.legend(fontsize="small")
     ax.set_title(f"{_title(solution)}\nload against displacement, t = 0..{solution.t[-1]:g}",
                  fontsize="medium")
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
+    return fig
+
+
+def plot_load_displacement(solution, path, curves=None):
+    """``load_displacement.png``: :func:`figure_load_displacement`."""
+    save_figure(figure_load_displacement(solution, curves), path)
 
 
 #: the figures :func:`write_plots` may draw, without the ``.png``

@@ -33,14 +33,27 @@ from .common import (
     scene_folder,
     study_source,
 )
-from .plots import DPI, plot_title
+from .plots import DPI, Units, plot_title
 from .scheduler import open_executor, scheduler_option
 
 #: the panels of each figure: (runs.csv column, axis label)
 PANELS = (("seconds", "wall time of the run (s)"),
           ("newton_total", "Newton iterations, all steps"),
           ("beta_mean_T", "mean bonding β at T"),
-          ("normal_force_T", "total normal contact force at T\n(> 0 compression)"))
+          ("normal_force_T", "total normal contact force at T\n(> 0 compression{force})"))
+
+
+def panel_label(label, units, dim):
+    """A panel's axis label; the force's unit (``[output] units``) filled in:
+    "; N", "; N/mm per unit thickness" in 2D, or nothing without units."""
+    force, length = units.given.get("force"), units.given.get("length")
+    if force is None:
+        unit = ""
+    elif dim == 3:
+        unit = f"; {force}"
+    else:
+        unit = f"; {force}/{length}" if length else f"; {force} per unit thickness"
+    return label.format(force=unit)
 
 
 def _numbers(values):
@@ -55,8 +68,11 @@ def _value(row, column):
     return math.nan if value is None else float(value)
 
 
-def plot_key(path, rows, keys, key, title):
-    """The measured quantities against one swept key, a line per setting of the others."""
+def figure_key(rows, keys, key, title, units=None, dim=2):
+    """The measured quantities against one swept key, a line per setting of
+    the others; ``units`` (:class:`~.plots.Units`) of the base scene, of
+    dimension ``dim``, name the force's unit."""
+    units = units or Units()
     values = list(dict.fromkeys(show(row[key]) for row in rows))
     raw = {show(row[key]): row[key] for row in rows}
     numbers = _numbers([raw[v] for v in values])
@@ -77,7 +93,7 @@ def plot_key(path, rows, keys, key, title):
             ax.plot(x[ok], y[ok], "o-", label=group or None)
             if column == "seconds" and (~ok).any():
                 ax.plot(x[~ok], y[~ok], "x", color="tab:red", markersize=9, mew=2)
-        ax.set_ylabel(label)
+        ax.set_ylabel(panel_label(label, units, dim))
         ax.grid(True, color="0.9", linewidth=0.6)
     if numbers is not None and numbers.min() > 0 and numbers.max() > 10 * numbers.min():
         axes[0, 0].set_xscale("log")
@@ -92,8 +108,16 @@ def plot_key(path, rows, keys, key, title):
     failed = sum(row["outcome"] != "ok" for row in rows)
     note = f"; × on the time panel: {failed} failed run(s)" if failed else ""
     fig.suptitle(f"{plot_title(title)}\nsweep over {key}{note}", fontsize="medium")
-    write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI), binary=True)
-    plt.close(fig)
+    return fig
+
+
+def plot_key(path, rows, keys, key, title, units=None, dim=2):
+    """``by_<key>.png``: :func:`figure_key`, written atomically."""
+    fig = figure_key(rows, keys, key, title, units, dim)
+    try:
+        write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI), binary=True)
+    finally:
+        plt.close(fig)
 
 
 def plot_name(key):
@@ -200,7 +224,8 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
             files = list(result.files)
             for key in keys:
                 files.append(plot_name(key))
-                plot_key(out / files[-1], result.rows, keys, key, study.base.title)
+                plot_key(out / files[-1], result.rows, keys, key, study.base.title,
+                         Units(study.base.units), study.base.dim)
         except ClusterError as err:
             raise CliError(f"--scheduler {err.address}: {err.message}; the finished runs are "
                            "saved, the same command resumes", 1) from None

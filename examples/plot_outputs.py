@@ -1,16 +1,18 @@
-"""Plot from a finished output folder of ``adhcontact solve``, with numpy,
-json and matplotlib only.
+"""Plot from a finished output folder of ``adhcontact solve``.
 
     python examples/plot_outputs.py [FOLDER]
 
 FOLDER holds summary.json and solution.npz. Without it, the script first
 runs ``adhcontact solve`` on a short copy of studies/scenes/debonding.toml
-into a temporary folder. It draws β along the contact side at a few times
-and the total normal force over time into beta_and_force.png, beside the
-outputs when FOLDER is given, else in the temporary folder.
+into a temporary folder. ``load_solution`` reads the folder back as the
+Solution that ``solve`` returns (its problem rebuilt from the scene kept in
+summary.json), so the library's post-processing works on it. It draws β
+along the contact side at a few times and the total normal force over time
+into beta_and_force.png, beside the outputs when FOLDER is given, else in
+the temporary folder. (The files are plain too: ``numpy.load`` and
+``json.load`` read them, docs/outputs.md.)
 """
 
-import json
 import subprocess
 import sys
 import tempfile
@@ -21,6 +23,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from adhesive_contact import load_solution  # noqa: E402
+from adhesive_contact.postprocess import beta_mean  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -40,13 +45,12 @@ def solve_into(folder):
 
 
 def plot(folder):
-    summary = json.loads((folder / "summary.json").read_text())
-    data = np.load(folder / "solution.npz")
-    points, facets = data["points"], data["contact_facets"]   # (npoints, d), (nf, d)
-    t, beta = data["t"], data["beta"]                          # (M+1,), (M+1, nf)
-    x = points[facets, 0].mean(axis=1)                         # facet midpoints along x
+    solution = load_solution(folder)
+    problem = solution.problem
+    t, beta = solution.t, solution.beta                        # (M+1,), (M+1, nf)
+    x = problem.mesh.p[0, problem.boundary.facet_nodes].mean(axis=0)   # facet midpoints
     order = np.argsort(x)
-    force = [step["normal_force"] for step in summary["steps"]]  # compression > 0
+    force = solution.total_normal_force()                      # compression > 0
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
     for n in np.linspace(0, t.size - 1, 5).astype(int):
@@ -55,12 +59,12 @@ def plot(folder):
     left.legend()
     right.plot(t, force)
     right.set(xlabel="t", ylabel="total normal force (compression > 0)")
-    fig.suptitle(f"{summary['scene']['title']} ({summary['run']['status']})")
+    status = "complete" if solution.success else solution.message
+    fig.suptitle(f"{problem.scene.title} ({status})")
     path = folder / "beta_and_force.png"
     fig.savefig(path, dpi=80)
     plt.close(fig)
-    print(f"{path}: {summary['run']['levels']} levels, β mean at T "
-          f"{summary['steps'][-1]['beta_mean']:.3f}")
+    print(f"{path}: {t.size} levels, β mean at T {beta_mean(solution)[-1]:.3f}")
     return path
 
 

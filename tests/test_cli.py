@@ -27,8 +27,8 @@ NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "n_wall", "separated", "on_wall", "stick", "slip", "max_penetration",
              "iterations", "residual", "reactions", "contact_force"}
-SUMMARY_KEYS = {"schema", "scene", "mesh", "run", "smallness", "warnings", "timings", "linear", "resources",
-                "iterations", "steps"}
+SUMMARY_KEYS = {"schema", "scene", "source", "mesh", "run", "smallness", "warnings", "timings",
+                "linear", "resources", "iterations", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
                   "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",
                   "trace_lower_estimate",
@@ -85,8 +85,13 @@ def test_solve_writes_every_output(solved):
 def test_npz_has_the_firm_keys_and_shapes(solved):
     _, out, _ = solved
     with np.load(out / "solution.npz") as data:
+        # the firm keys, and the rest of the Solution (for load_solution)
         assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta",
-                                   "reactions", "reaction_sides"}
+                                   "reactions", "reaction_sides"} | {
+            "contact_force", "frame_displacement", "on_wall", "stuck", "probes", "iterations",
+            "residual", "held_reaction", "stress_last", "stress_zz_last"}
+        assert data["stress_last"].shape == (NCELLS, 2, 2)
+        assert data["stress_zz_last"].shape == (NCELLS,)
         assert list(data["reaction_sides"]) == ["top"]
         assert data["reactions"].shape == (NLEVELS, 1, 2)
         assert data["points"].shape == (NPOINTS, 2)
@@ -325,6 +330,8 @@ BAD_SCENES = [
     ("steps zero", {"time.steps": 0}, "time.steps"),
     ("prony tau", {"memory": prony((200.0, 0.3, 0.0))}, "memory.terms[0].tau"),
     ("unknown side", {"boundary.dirichlet": ["middle"]}, "boundary.dirichlet"),
+    ("held by glue only", {"boundary.dirichlet": []},
+     'boundary.dirichlet: must list at least one side: nothing holds the body; the glue'),
     ("disallowed name", {"loads.body": ["0", "__import__('os')"]}, "loads.body[1]"),
     ("attribute access", {"loads.body": ["0", "t.real"]}, "loads.body[1]"),
     ("probe outside", {"output.probes": [[1.0, 0.0], [5.0, 0.5]]}, "output.probes[1]"),

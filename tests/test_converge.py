@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import assert_one_line_error, law, prony, scene_dict, to_toml
+from conftest import assert_one_line_error, law, prony, reference_mesh, scene_dict, to_toml
+from skfem import Basis, ElementTriP1, ElementVector, Functional
+from skfem.helpers import ddot, sym_grad
 
 import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, parse_scene
@@ -170,8 +172,24 @@ def test_exact_study_writes_the_firm_outputs(exact_study):
     assert study["scene"]["exact"]["u"] == ["0.01*x*x*(1+t)", "0.005*x*y"]
     assert len(study["sha256"]) == 64
 
+    # relative errors: over max_t ‖ε(u*)‖, by hand for u* = (0.01 x²(1+t), 0.005 x y)
+    # on [0, 1] × [0, 0.5] at t = T = 1: ε = [[0.04 x, 0.0025 y], [0.0025 y, 0.005 x]]
+    norm = np.sqrt(0.04**2 / 3 * 0.5 + 0.005**2 / 3 * 0.5 + 2 * 0.0025**2 * 0.5**3 / 3)
+    for level in levels:
+        assert level["rel_u"] * norm == pytest.approx(level["err_u"], rel=1e-10)
+        assert level["rel_E"] == level["rel_u"] and level["rel_beta"] is None   # no Γ_C
+    assert 0.01 < levels[-1]["rel_u"] < levels[0]["rel_u"] < 0.5
+
     stdout = exact_study.result.stdout
     assert "‖ε(u−u_h)‖" in stdout and "least-squares rates" in stdout
+    # the table says which norms, which times, against what, which h; rel beside each error
+    assert ("‖ε(u−u_h)‖ = ‖ε(u(t_n)) − ε(u_h^n)‖ in L²(Ω);  ‖β−β_h‖ = ‖β(t_n) − β_h^n‖ in "
+            "L²(Γ_C);  E = max of their sum") in stdout
+    assert "each the max over the time levels t_n" in stdout
+    assert "u, β: the scene's exact solution" in stdout
+    assert "h = the largest edge length (cell diameter) of the mesh" in stdout
+    row = next(line for line in stdout.splitlines() if line.split()[:1] == ["0"])
+    assert row.split()[4:6] == [f"{levels[0]['err_u']:.3e}", f"{levels[0]['rel_u']:.1e}"]
     assert "needed" in exact_study.result.stderr or ">= 4" in exact_study.result.stderr
 
 
@@ -220,6 +238,18 @@ def test_fine_reference_k_study(fine_study, scenes):
         np.testing.assert_allclose(saved["u"], fresh.u, rtol=0, atol=1e-15)
         np.testing.assert_array_equal(saved["facets"], fresh.facets)
     assert np.abs(fresh.u[-1]).max() > 1e-4      # the block moves: the errors mean something
+    # relative errors over the reference's own norms on the level's time grid,
+    # ‖ε(u_ref)‖ by scikit-fem here; β_ref = 1 on Γ_C (no bonding law): ‖β_ref‖ = √|Γ_C| = 1
+    basis = Basis(reference_mesh([1.0, 0.5], [4, 2]), ElementVector(ElementTriP1()))
+    strain_norm = Functional(lambda w: ddot(sym_grad(w["u"]), sym_grad(w["u"])))
+    for level in levels:
+        ratio = steps // level["steps"]
+        norms = np.sqrt([strain_norm.assemble(basis, u=basis.interpolate(fresh.u[n].ravel()))
+                         for n in range(0, steps + 1, ratio)])
+        assert level["rel_u"] == pytest.approx(level["err_u"] / norms.max(), rel=1e-10)
+        assert level["rel_beta"] == 0.0 and level["err_beta"] == 0.0
+        assert level["rel_E"] == pytest.approx(level["E"] / (norms + 1.0).max(), rel=1e-10)
+    assert "u, β: the fine reference run" in fine_study.result.stdout
 
 
 # ---------------------------------------------------------------- (3) resume
@@ -234,6 +264,23 @@ def test_rerun_recomputes_nothing(fine_study, tmp_path, scenes, counting):
     assert counting.levels == [] and counting.reference == 0
     assert snapshot(out) == before           # rates.json, errors.csv, ... identical
     assert "0 of 3 levels computed now" in result.stdout
+
+
+def test_a_study_saved_before_relative_errors_resumes_without_them(exact_study, tmp_path,
+                                                                   scenes, counting):
+    out = tmp_path / "out"
+    shutil.copytree(exact_study.out, out)
+    for path in (out / "levels").iterdir():       # level records as an older version wrote
+        record = json.loads(path.read_text())
+        path.write_text(json.dumps({k: v for k, v in record.items()
+                                    if not k.startswith("rel_")}))
+    result = run(scenes.exact, "--param", "h", "--levels", 3, "--out", out)
+    assert result.exit_code == 0, result.stderr
+    assert counting.levels == [] and "0 of 3 levels computed now" in result.stdout
+    levels = strict_json(out / "rates.json")["levels"]
+    assert all(level[key] is None for level in levels for key in ("rel_u", "rel_beta", "rel_E"))
+    row = next(line for line in result.stdout.splitlines() if line.split()[:1] == ["0"])
+    assert row.split()[4:6] == [f"{levels[0]['err_u']:.3e}", "—"]
 
 
 def test_interrupted_study_computes_only_the_missing_levels(fine_study, tmp_path, scenes,

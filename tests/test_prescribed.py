@@ -113,6 +113,31 @@ def test_bad_displacement_tables_name_the_key(changes, message):
     assert message in str(err.value)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_body_held_only_by_glue_is_told_what_to_hold_and_the_advice_works(dim):
+    base = scene_dict({"boundary.dirichlet": [], "contact.normal": {
+        "law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01}})
+    if dim == 3:
+        base = scene_dict({"dim": 3, "mesh.domain": "box", "mesh.size": [2.0, 0.5, 0.5],
+                           "mesh.cells": [4, 2, 2]}, base)
+    with pytest.raises(SceneError) as err:
+        scene_from_dict(base)
+    message = str(err.value)
+    assert "\n" not in message
+    assert message.startswith("boundary.dirichlet: must list at least one side: nothing "
+                              "holds the body; the glue of boundary.contact (bottom) cannot "
+                              "hold it alone")
+    held = ", ".join(['"0"'] * (dim - 1) + ['"0.01*t"'])
+    assert f'boundary.dirichlet = ["left"]' in message
+    assert f"[boundary.displacement], e.g. left = [{held}]" in message
+    # either fix the message names is a valid scene that holds every rigid motion
+    build_problem(scene_from_dict(scene_dict({"boundary.dirichlet": ["left"]}, base)))
+    moved = scene_dict({"boundary.displacement": {"left": ["0"] * (dim - 1) + ["0.01*t"]}},
+                       base)
+    problem = build_problem(scene_from_dict(moved))
+    assert problem.prescribed.fixed.size == dim * np.isclose(problem.mesh.p[0], 0).sum()
+
+
 def test_a_contact_node_with_a_held_component_leaves_contact():
     data = scene_dict({"boundary.dirichlet": ["top"],
                        "boundary.displacement": {"left": ["0", "free"]},

@@ -6,11 +6,15 @@
 - :mod:`.streaming`: :class:`StreamingRecorder`, a recorder for
   :func:`adhesive_contact.solve` that writes each level to those files as it
   is computed and keeps in memory only what is small (per contact node or
-  facet, per probe): the memory of a run is flat in the number of steps.
+  facet, per probe): the memory of a run is flat in the number of steps;
+- :mod:`.load`: :func:`load_solution`, an output folder read back as the
+  Solution that ``solve`` returns.
 """
 
+from .load import OutputFolderError, load_solution
 from .npz import write_npz
 from .streaming import StreamingRecorder
 from .xdmf import XdmfSeries, write_xdmf
 
-__all__ = ["StreamingRecorder", "XdmfSeries", "write_npz", "write_xdmf"]
+__all__ = ["OutputFolderError", "StreamingRecorder", "XdmfSeries", "load_solution",
+           "write_npz", "write_xdmf"]

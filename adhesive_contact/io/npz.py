@@ -1,8 +1,17 @@
-"""``solution.npz`` (keys ``points``, ``cells``, ``contact_facets``, ``t``,
-``u``, ``beta``, ``reactions`` (N+1, n_sides, d): the force of each held
-side's support on the body, ``reaction_sides``: their names), written entry by entry into a compressed zip, as
+"""``solution.npz``, written entry by entry into a compressed zip, as
 :func:`numpy.savez_compressed` would write it, but with the history u
-(N+1, npoints, d) streamed level by level from wherever it is kept."""
+(N+1, npoints, d) streamed level by level from wherever it is kept.
+
+Keys (docs/outputs.md): ``points``, ``cells``, ``contact_facets``, ``t``,
+``u``, ``beta``, ``reactions`` (N+1, n_sides, d): the force of each held
+side's support on the body, ``reaction_sides``: their names; and the rest
+of a :class:`~adhesive_contact.Solution` (:data:`SOLUTION_KEYS`), so that
+:func:`~adhesive_contact.io.load_solution` gives it back: ``contact_force``,
+``frame_displacement``, ``on_wall``, ``stuck``, ``probes``, ``iterations``,
+``residual``, ``held_reaction`` (the reaction per held dof), and the stress
+of the last level, ``stress_last`` (ncells, d, d) and, in 2D,
+``stress_zz_last`` (ncells,).
+"""
 
 import zipfile
 
@@ -29,6 +38,12 @@ def _write_levels(archive, name, levels, count):
             f.write(np.ascontiguousarray(levels[n], dtype=float).tobytes())
 
 
+#: the Solution's per-level arrays kept under their own names; held_reaction
+#: is Solution.reaction
+SOLUTION_KEYS = ("contact_force", "frame_displacement", "on_wall", "stuck", "probes",
+                 "iterations", "residual")
+
+
 def write_npz(solution, path):
     """Write ``solution.npz`` of a solution (its u may be kept on disk, see
     :class:`~adhesive_contact.io.StreamingRecorder`)."""
@@ -42,3 +57,11 @@ def write_npz(solution, path):
         _write_array(archive, "beta", solution.beta)
         _write_array(archive, "reactions", reactions(solution))
         _write_array(archive, "reaction_sides", np.array(reaction_sides(problem), dtype=str))
+        for name in SOLUTION_KEYS:
+            _write_array(archive, name, getattr(solution, name))
+        held = solution.reaction if solution.reaction is not None else \
+            np.zeros((solution.t.size, 0))
+        _write_array(archive, "held_reaction", held)
+        _write_array(archive, "stress_last", solution.stress[-1])
+        if solution.stress_zz is not None:
+            _write_array(archive, "stress_zz_last", solution.stress_zz[-1])

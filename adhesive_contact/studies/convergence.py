@@ -53,6 +53,9 @@ from .study import RunFailed, Study, StudyError, scene_identity, scene_source
 REFERENCE = "reference.npz"
 LEVELS = "levels"
 FLOAT_KEYS = ("h", "k", "err_u", "err_beta", "E", "seconds")
+#: the relative errors of a level; a level saved before they existed has
+#: none (null in rates.json), and stays valid: a study resumes as it was
+RELATIVE_KEYS = ("rel_u", "rel_beta", "rel_E")
 RECORD_KEYS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "seconds")
 CSV_COLUMNS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
                "seconds")
@@ -108,18 +111,26 @@ def results(records, param, reference_info):
 
     Firm keys: ``{"param", "levels": [{"h", "k", "dofs", "err_u", "err_beta",
     "E", "seconds", ...}], "rates": {"u", "beta", "E"}}``; each level also
-    has its level, steps, refine, the pairwise rate_E and its Newton
-    iterations, and ``"reference"`` describes the reference."""
+    has its level, steps, refine, the relative errors rel_u, rel_beta,
+    rel_E (None for a level saved without them, or a zero solution), the
+    pairwise rate_E and its Newton iterations, and ``"reference"``
+    describes the reference."""
     pairwise = pairwise_rates(records, param)
     levels = []
     for record, rate in zip(records, pairwise):
         levels.append({key: record[key] for key in ("h", "k", "dofs", "err_u", "err_beta",
                                                      "E", "seconds")}
+                      | {key: _finite(record.get(key)) for key in RELATIVE_KEYS}
                       | {"level": record["level"], "steps": record["steps"],
                          "refine": record.get("refine"), "rate_E": rate,
                          "newton_iterations": record.get("newton_iterations")})
     return {"param": param, "levels": levels, "rates": rates(records, param),
             "reference": reference_info}
+
+
+def _finite(value):
+    """A float, or None for a missing, null or NaN value."""
+    return None if value is None or not math.isfinite(value) else float(value)
 
 
 #: pairwise rates further apart than this, or any below 0, make a fit doubtful

@@ -82,11 +82,13 @@ def scene_source(scene):
 
 def scene_identity(scene):
     """What a scene contributes to a study's identity: its resolved record
-    without ``solver.linear``. The linear backend changes how the linear
-    systems are solved, not the discrete solution (every backend solves to
-    round-off or its tolerance), so a study may resume with another one."""
+    without ``solver.linear`` and ``output.units``. The linear backend
+    changes how the linear systems are solved, not the discrete solution
+    (every backend solves to round-off or its tolerance), and the units
+    name the plots' axes only, so a study may resume with other ones."""
     resolved = dict(scene.resolved)
     resolved["solver"] = {k: v for k, v in resolved["solver"].items() if k != "linear"}
+    resolved["output"] = {k: v for k, v in resolved["output"].items() if k != "units"}
     return resolved
 
 
