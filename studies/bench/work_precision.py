@@ -1,7 +1,7 @@
 """Work and precision: the error E against the wall time of a run, across
 the choices a user makes.
 
-    python studies/bench/work_precision.py            # about 6 minutes here
+    python studies/bench/work_precision.py            # about 5 minutes here
 
 The scene is the manufactured case (b) of ``studies/convergence/``
 (``b_wall_multiplier.toml``: memory, adhesive compliance, a wall with a
