@@ -2,13 +2,16 @@
 docs/examples in its test suite."""
 
 import re
+import tomllib
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import scene_dict
 
 from adhesive_contact import build_problem, load_scene, parse_scene, solve
+from adhesive_contact.scene import scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "studies").glob("*/*.toml"))
@@ -43,3 +46,17 @@ def test_readme_python_example_runs(monkeypatch):
     monkeypatch.chdir(ROOT)
     exec(compile(block, "README.md", "exec"), namespace)   # our own README, not input
     assert namespace["solution"].u.shape[0] == namespace["scene"].steps + 1
+
+
+def test_conmech_setup0_scene_is_the_peer_problem():
+    """studies/bench/conmech_setup0.toml has conmech's 5233 nodes, and its
+    Lamé pair λ = μ = 4 is the pair E = 10, ν = 0.25 of its comment: the
+    same displacements to round-off."""
+    path = ROOT / "studies/bench/conmech_setup0.toml"
+    lame = solve(build_problem(load_scene(path)))
+    assert lame.problem.mesh.p.shape[1] == 5233
+    data = scene_dict({"material": {"E": 10.0, "nu": 0.25}}, tomllib.loads(path.read_text()))
+    young = solve(build_problem(scene_from_dict(data)))
+    assert np.abs(young.u - lame.u).max() <= 1e-12 * np.abs(lame.u).max()
+    # the body force pushes Γ_C into the layer: every contact node is in compliance
+    assert (lame.normal_displacement[-1] > 0).all()

@@ -131,6 +131,10 @@ def test_a_field_the_scheme_represents_exactly_has_round_off_errors():
     record = run_level(scene, "h", 0)
     # errors against |ε(u*)| ≈ 1e-2 and β* = 0.7: round-off, not discretisation
     assert record["err_u"] < 1e-12 and record["err_beta"] < 1e-12
+    # the wall time splits into set-up and time loop, both spent
+    assert record["setup_seconds"] > 0 and record["stepping_seconds"] > 0
+    assert record["setup_seconds"] + record["stepping_seconds"] == pytest.approx(
+        record["seconds"], rel=1e-12)
 
 
 # ---------------------------------------------------------------- prolongation
