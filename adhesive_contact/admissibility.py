@@ -31,6 +31,7 @@ from .expressions import coordinates
 from .manufactured import TOLERANCE, on_wall
 from .scene import SceneError
 
+
 #: relative tolerance of the checks, and of the contact and stick sets
 def _where(x, i, t):
     return "(" + ", ".join(f"{c:.4g}" for c in x[:, i]) + f"), t = {t:g}"

@@ -30,8 +30,8 @@ from .bonding import INTEGRATORS
 from .expressions import ExpressionError, compile_expression
 from .laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
 from .linear_solvers import METHODS
-from .manufactured import symbolic_problem
 from .linear_solvers.pardiso import available as pardiso_available
+from .manufactured import symbolic_problem
 from .step_methods import METHODS as STEP_METHODS
 
 
@@ -45,6 +45,7 @@ class SceneError(ValueError):
 
 #: the ranges every scene must keep (see the readers that use them for why)
 MAX_TITLE = 500             # characters of the title (it heads every plot)
+LINEAR_TOL_RANGE = (1e-14, 1e-2)   # below: round-off; above: a solve that barely acts
 LENGTHS = (1e-6, 1e6)       # each length of the domain; rescale the units outside
 MAX_CELL_ASPECT = 1e3       # longest over shortest edge of the structured cells
 MAX_NODES = 10**8           # nodes of the refined mesh
@@ -204,6 +205,9 @@ class SolverSpec:
     """The ``[solver]`` table.
 
     ``method`` the step method (:mod:`adhesive_contact.step_methods`);
+    ``linear_tol`` the relative residual ‖b − A x‖ ≤ linear_tol ‖b‖ of each
+    solve of the iterative backend (AMG-preconditioned CG; the direct
+    backends solve to round-off and ignore it);
     ``penalty`` and ``smoothing`` are read by ``method = "penalty"`` only:
     the wall's penalty stiffness is ρ = penalty · max_i S_ii (the largest
     diagonal entry of the step's condensed matrix), so the wall violation
@@ -218,6 +222,7 @@ class SolverSpec:
     linear: str = "auto"          # the linear backend (adhesive_contact.linear_solvers)
     penalty: float = 1e4          # relative to max diag S
     smoothing: float = 1e-6       # relative to the diameter of the body
+    linear_tol: float = 1e-10     # AMG's CG: relative residual of each linear solve
 
 
 @dataclass(frozen=True)
@@ -355,6 +360,8 @@ def _contact_record(contact):
 def _solver_record(solver):
     record = {"method": solver.method, "tol": solver.tol, "max_iter": solver.max_iter,
               "linear": solver.linear}
+    if solver.linear_tol != SolverSpec.linear_tol:   # recorded when set: study identities keep
+        record["linear_tol"] = solver.linear_tol
     if solver.method == "penalty":
         record.update(penalty=solver.penalty, smoothing=solver.smoothing)
     return record
@@ -387,7 +394,7 @@ KNOWN_KEYS = {
     "contact.foundation": {"shape", "point", "normal", "radius", "axis"},
     "contact.bonding": {"law", "beta0", "integrator", "gamma_nu", "gamma_tau", "eps_a", "L"},
     "time": {"T", "steps"},
-    "solver": {"method", "tol", "max_iter", "linear", "penalty", "smoothing"},
+    "solver": {"method", "tol", "max_iter", "linear", "linear_tol", "penalty", "smoothing"},
     "output": {"probes", "units"},
     "output.units": set(UNIT_KEYS),
     "exact": {"u", "beta", "multiplier"},
@@ -948,8 +955,13 @@ def _read_solver(table):
     penalty = _positive("solver.penalty", table.get("penalty", "number", SolverSpec.penalty))
     smoothing = _positive("solver.smoothing",
                           table.get("smoothing", "number", SolverSpec.smoothing))
+    linear_tol = table.get("linear_tol", "number", SolverSpec.linear_tol)
+    lo, hi = LINEAR_TOL_RANGE
+    if not lo <= linear_tol <= hi:
+        raise SceneError("solver.linear_tol", f"must lie in [{lo:g}, {hi:g}], got "
+                         f"{linear_tol:g}: the relative residual of each iterative linear solve")
     table.finish()
-    return SolverSpec(method, tol, max_iter, linear, penalty, smoothing)
+    return SolverSpec(method, tol, max_iter, linear, penalty, smoothing, linear_tol)
 
 
 def _read_output(table, dim):

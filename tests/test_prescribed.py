@@ -128,7 +128,7 @@ def test_a_body_held_only_by_glue_is_told_what_to_hold_and_the_advice_works(dim)
                               "holds the body; the glue of boundary.contact (bottom) cannot "
                               "hold it alone")
     held = ", ".join(['"0"'] * (dim - 1) + ['"0.01*t"'])
-    assert f'boundary.dirichlet = ["left"]' in message
+    assert 'boundary.dirichlet = ["left"]' in message
     assert f"[boundary.displacement], e.g. left = [{held}]" in message
     # either fix the message names is a valid scene that holds every rigid motion
     build_problem(scene_from_dict(scene_dict({"boundary.dirichlet": ["left"]}, base)))

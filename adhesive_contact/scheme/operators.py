@@ -72,7 +72,8 @@ class StepOperators:
             # the rigid body modes of AMG in Cartesian components (the few
             # rotated dofs at Γ_C only weaken its near-nullspace there)
             solver = make_linear_solver(A_II, method, dim=problem.dim, points=problem.mesh.p,
-                                        dofs=free[interior])
+                                        dofs=free[interior],
+                                        tol=problem.scene.solver.linear_tol)
             solver.reason = reason
             return solver
 

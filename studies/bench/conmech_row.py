@@ -31,7 +31,6 @@ beside this script and prints the two rows.
 import argparse
 import csv
 import datetime
-import json
 import os
 import platform
 import resource

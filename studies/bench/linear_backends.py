@@ -78,9 +78,8 @@ def reset_peak():
 
 def measure(path, backend, threads):
     """Run in a child process: one backend on the saved matrix."""
-    from threadpoolctl import threadpool_limits
-
     import pyamg  # noqa: F401  (loaded before the baseline: libraries are not the solver's memory)
+    from threadpoolctl import threadpool_limits
 
     from adhesive_contact.linear_solvers import make_linear_solver, pardiso
 

@@ -29,11 +29,7 @@ Series:
 - an h × k grid with SuperLU and nodal quadrature (8 × 8 to 128 × 128
   cells × 4–128 steps): rows are h-sweeps at fixed k, columns k-sweeps at fixed h.
 
-The AMG tolerance is not a scene key: the step operators build AMG with
-:func:`~adhesive_contact.linear_solvers.make_linear_solver`'s default
-(1e-10). This script sets another one by rebinding that function in
-:mod:`adhesive_contact.scheme.operators` for the runs of that series only
-(:func:`amg_tolerance`).
+The AMG tolerance is the scene key ``[solver] linear_tol`` (default 1e-10).
 
 Writes ``work_precision.csv``, ``work_precision.json`` (the points, the
 machine and the cheapest run with E ≤ 1e-3) and ``work_precision.png``
@@ -41,11 +37,8 @@ beside this script, and prints a table.
 """
 
 import argparse
-import contextlib
 import csv
 import datetime
-import functools
-import json
 import math
 import os
 import platform
@@ -65,41 +58,30 @@ GRID_REFINE = range(1, 6)
 GRID_STEPS = (4, 8, 16, 32, 64, 128)
 
 
-@contextlib.contextmanager
-def amg_tolerance(tol):
-    """Runs inside build AMG with CG to relative residual ``tol``."""
-    from adhesive_contact.linear_solvers import make_linear_solver
-    from adhesive_contact.scheme import operators
-
-    operators.make_linear_solver = functools.partial(make_linear_solver, tol=tol)
-    try:
-        yield
-    finally:
-        operators.make_linear_solver = make_linear_solver
-
-
-def variant(base, *, linear="superlu", quadrature="nodal", refine=0, steps=4):
-    """The base scene with a backend, a quadrature, a refinement and steps."""
+def variant(base, *, linear="superlu", quadrature="nodal", refine=0, steps=4, amg_tol=None):
+    """The base scene with a backend (and AMG's tolerance), a quadrature, a
+    refinement and steps."""
     from adhesive_contact.convergence import with_discretisation
 
-    scene = replace(base, solver=replace(base.solver, linear=linear),
+    solver = replace(base.solver, linear=linear)
+    if amg_tol is not None:
+        solver = replace(solver, linear_tol=amg_tol)
+    scene = replace(base, solver=solver,
                     contact=replace(base.contact, quadrature=quadrature))
     return with_discretisation(scene, refine, steps)
 
 
-def measure(scene, amg_tol=None):
+def measure(scene):
     """One run (level 0 of an h-study of ``scene``): its record, timed by
     the fastest of 3 when it takes under REPEAT_BELOW seconds, else of 2."""
     from adhesive_contact.convergence import run_level
 
-    tolerance = amg_tolerance(amg_tol) if amg_tol is not None else contextlib.nullcontext()
-    with tolerance:
-        try:
-            record = run_level(scene, "h", 0)
-        except Exception as err:   # a failed point is a result too
-            return {"status": f"failed: {type(err).__name__}: {err}".splitlines()[0]}
-        repeats = 2 if record["seconds"] < REPEAT_BELOW else 1
-        runs = [record] + [run_level(scene, "h", 0) for _ in range(repeats)]
+    try:
+        record = run_level(scene, "h", 0)
+    except Exception as err:   # a failed point is a result too
+        return {"status": f"failed: {type(err).__name__}: {err}".splitlines()[0]}
+    repeats = 2 if record["seconds"] < REPEAT_BELOW else 1
+    runs = [record] + [run_level(scene, "h", 0) for _ in range(repeats)]
     best = min(runs, key=lambda r: r["seconds"])
     return {**best, "status": "ok"}
 
@@ -229,8 +211,9 @@ def main():
           f"{'seconds':>8} {'set-up':>7} {'stepping':>8}  status", flush=True)
     rows = []
     for series, choice, linear, quadrature, tol, refine, steps in points(base, backends):
-        scene = variant(base, linear=linear, quadrature=quadrature, refine=refine, steps=steps)
-        record = measure(scene, tol)
+        scene = variant(base, linear=linear, quadrature=quadrature, refine=refine, steps=steps,
+                        amg_tol=tol)
+        record = measure(scene)
         cells = base.mesh.cells[0] * 2**refine
         row = {"series": series, "choice": choice, "linear": linear, "quadrature": quadrature,
                "amg_tol": tol,

@@ -26,7 +26,6 @@ machine. See studies/README.md, "Stability maps", for the discussion.
 
 import argparse
 import csv
-import math
 import tomllib
 from pathlib import Path
 
