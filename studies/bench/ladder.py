@@ -1,9 +1,10 @@
 """The cost of a run from 1e3 to 1e6 dofs: the benchmark of the solver.
 
-A ladder of scenes in 2D and 3D, frictionless (compliance and a wall) and
-the full model (memory, adhesive compliance, slip weakening and an
-adhesive spring, Frémond bonding, a wall), 20 steps each, for each linear
-backend asked for. Every case runs in its own process (so its peak memory
+A ladder of scenes in 2D and 3D, frictionless (compliance and a wall), the
+full model (memory, adhesive compliance, slip weakening and an adhesive
+spring, Frémond bonding, a wall) and its baseline "elastic" (the same mesh
+and loads with no contact terms and no memory), 20 steps each, for each
+linear backend asked for. Every case runs in its own process (so its peak memory
 is its own) and records:
 
 - ``dofs``, ``contact_unknowns``;
@@ -18,7 +19,8 @@ is its own) and records:
 
 It writes ``ladder.csv``, ``ladder.json`` (with the machine) and
 ``ladder.png`` beside this script, and prints the fitted growth exponents
-of set-up and step time in the dofs.
+of set-up and step time in the dofs and, per size, the full model's total
+time over its elastic baseline's.
 
     python studies/bench/ladder.py [--max-dofs 1.1e6] [--backends auto,superlu,amg]
 
@@ -43,15 +45,17 @@ HERE = Path(__file__).resolve().parent
 STEPS = 20
 
 # size parameter m -> cells; dofs ≈ 2 (8m+1)(m+1) in 2D, 3 (4m+1)(m+1)(2m+1) in 3D.
-# The 3D full model stops at 1e4 dofs: at 1.1e5 its 6435 contact unknowns
-# make each Newton iteration a dense 6435² Cholesky (about 1e11 flops), some
-# 200 of them in 20 steps: the dense Schur complement is the limit there
+# The 3D full model at 1.1e5 dofs has 6336 contact unknowns: each Newton
+# iteration is a dense Cholesky of up to that size (a second or more), some
+# 260 of them in 20 steps
 LADDER = {(2, "frictionless"): [8, 25, 80, 250], (2, "full"): [8, 25, 80, 250],
-          (3, "frictionless"): [3, 7, 16], (3, "full"): [3, 7]}
+          (2, "elastic"): [8, 25, 80, 250],
+          (3, "frictionless"): [3, 7, 16], (3, "full"): [3, 7, 16], (3, "elastic"): [3, 7, 16]}
 # SuperLU in 3D: its minimum degree fill grows like n^(5/3) (39 s to factorise
-# 4e4 dofs, studies/bench/linear_backends.py); a case takes four such
-# factorisations, so 1e5 dofs would take a quarter of an hour: skipped
-SKIP = {("superlu", 3): 2e4}
+# 4e4 dofs, studies/bench/linear_backends.py); a case takes up to three such
+# factorisations, so 1e5 dofs would take a quarter of an hour: skipped; in
+# 2D at 1e6 dofs its factors take 5 GB
+SKIP = {("superlu", 3): 2e4, ("superlu", 2): 3e5}
 
 GLUE = {
     "normal": {"law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01},
@@ -75,10 +79,12 @@ def scene(dim, m, model, backend):
            "material": {"E": 1000.0, "nu": 0.3},
            "time": {"T": 1.0, "steps": STEPS},
            "solver": {"linear": backend}}
-    if model == "full":
+    if model in ("full", "elastic"):
         doc["memory"] = {"kernel": "prony", "terms": [{"E": 200.0, "nu": 0.3, "tau": 0.5}]}
         doc["loads"] = {"traction": {"right": pull}}
         doc["contact"] = {"gap": 0.05, **GLUE}
+        if model == "elastic":   # the baseline: no contact terms, no memory
+            doc.pop("memory"), doc.pop("contact"), doc["boundary"].pop("contact")
     else:   # pressed onto a compliant layer and a wall, no friction
         doc["loads"] = {"body": ["0", "-40*t"] + (["0"] if dim == 3 else [])}
         doc["contact"] = {"gap": 0.002, "normal": {"law": "compliance", "c": 1e4}}
@@ -94,6 +100,8 @@ def run_case(doc):
     problem = build_problem(scene_from_dict(doc))
     assembly = time.perf_counter() - t0
     solution = solve(problem)
+    total = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     timings = solution.timings
     # the linear work of one step, with the run's backend
     memory = problem.start_memory()
@@ -106,16 +114,17 @@ def run_case(doc):
         pairs.append(time.perf_counter() - t)
     per_step = timings["stepping"] / solution.t.size
     return {
-        "dim": doc["dim"], "model": "full" if "memory" in doc else "frictionless",
+        "dim": doc["dim"], "model": doc["title"].split()[-1],
         "backend": solution.linear["method"], "dofs": int(problem.ndofs),
-        "contact_unknowns": int(problem.columns.size), "steps": STEPS,
+        "contact_unknowns": int(problem.columns.size) if problem.boundary is not None else 0,
+        "steps": STEPS,
         "success": bool(solution.success),
         "assembly": assembly, "setup": timings["factorisation"], "stepping": timings["stepping"],
-        "total": time.perf_counter() - t0, "per_step": per_step,
+        "total": total, "per_step": per_step,
         "solve_pair": float(np.median(pairs)),
         "pairs_per_step": per_step / float(np.median(pairs)),
         "newton_per_step": float(solution.iterations[1:].mean()) if solution.t.size > 1 else 0.0,
-        "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "peak_mib": peak,
     }
 
 
@@ -211,7 +220,22 @@ def main():
         if e["setup"] is not None:
             print(f"growth in dofs, {name}: set-up ~ n^{e['setup']:.2f}, "
                   f"step ~ n^{e['per_step']:.2f}")
+    for row in rows:
+        row["over_elastic"] = over_elastic(row, rows)
+        if row["model"] == "full" and row["over_elastic"] is not None:
+            print(f"{row['dim']}D full / elastic, {row['backend']}, {row['dofs']} dofs: "
+                  f"{row['over_elastic']:.2f} x")
     write(rows, exponents)
+
+
+def over_elastic(row, rows):
+    """The total time of ``row`` over that of the elastic baseline of its
+    dimension, size and backend, or None."""
+    for other in rows:
+        if (other["model"] == "elastic" and other["dim"] == row["dim"]
+                and other["dofs"] == row["dofs"] and other["backend"] == row["backend"]):
+            return row["total"] / other["total"]
+    return None
 
 
 if __name__ == "__main__":
