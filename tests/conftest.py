@@ -236,3 +236,14 @@ def relative_max(a, b):
 @pytest.fixture
 def rng():
     return np.random.default_rng(20240611)
+
+
+def runner():
+    """A click CliRunner keeping stderr apart (click >= 8.2 always does)."""
+    import inspect
+
+    from click.testing import CliRunner
+
+    if "mix_stderr" in inspect.signature(CliRunner).parameters:
+        return CliRunner(mix_stderr=False)
+    return CliRunner()

@@ -1,6 +1,5 @@
 """Tests for the ``adhcontact`` command line (docs/outputs.md)."""
 
-import inspect
 import json
 import tomllib
 from importlib import resources
@@ -9,8 +8,7 @@ import meshio
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import DELETE, assert_one_line_error, law, prony, scene_dict, to_toml
+from conftest import DELETE, assert_one_line_error, law, prony, runner, scene_dict, to_toml
 
 from adhesive_contact import build_problem, parse_scene, solve
 
@@ -41,13 +39,6 @@ def edit(text, old, new):
     """``text`` with its one occurrence of ``old`` replaced by ``new``."""
     assert text.count(old) == 1, old
     return text.replace(old, new)
-
-
-def runner():
-    """A CliRunner keeping stderr apart (click >= 8.2 always does)."""
-    if "mix_stderr" in inspect.signature(CliRunner).parameters:
-        return CliRunner(mix_stderr=False)
-    return CliRunner()
 
 
 def run(*args):

@@ -3,7 +3,6 @@ the firm outputs, the fine reference, resuming, refusing another study and
 running levels in parallel. Tiny scenes (4x2 cells, a few steps, 3 levels)."""
 
 import csv
-import inspect
 import json
 import shutil
 from pathlib import Path
@@ -12,8 +11,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import assert_one_line_error, law, prony, reference_mesh, scene_dict, to_toml
+from conftest import assert_one_line_error, law, prony, reference_mesh, runner, scene_dict, to_toml
 from skfem import Basis, ElementTriP1, ElementVector, Functional
 from skfem.helpers import ddot, sym_grad
 
@@ -41,13 +39,6 @@ REF_K = default_reference_refinement("k")[1]
 FIRM_LEVEL_KEYS = {"h", "k", "dofs", "err_u", "err_beta", "E", "seconds"}
 CSV_COLUMNS = ["level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
                "seconds"]
-
-
-def runner():
-    """A CliRunner keeping stderr apart (click >= 8.2 always does)."""
-    if "mix_stderr" in inspect.signature(CliRunner).parameters:
-        return CliRunner(mix_stderr=False)
-    return CliRunner()
 
 
 def run(*args):

@@ -6,7 +6,6 @@ run; a worker killed mid-run is retried, one killed every time is a lost
 row; an unreachable scheduler is one line, exit 2."""
 
 import csv
-import inspect
 import json
 import os
 import socket
@@ -16,8 +15,7 @@ from types import SimpleNamespace
 import dask
 import pytest
 from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import assert_one_line_error, law, prony, scene_dict, to_toml, wall_block
+from conftest import assert_one_line_error, law, prony, runner, scene_dict, to_toml, wall_block
 from distributed import LocalCluster
 
 import adhesive_contact.studies.executors as executors
@@ -66,12 +64,6 @@ def scenes(tmp_path_factory):
     (folder / "block.toml").write_text(BLOCK)
     (folder / "contact.toml").write_text(CONTACT)
     return SimpleNamespace(block=folder / "block.toml", contact=folder / "contact.toml")
-
-
-def runner():
-    if "mix_stderr" in inspect.signature(CliRunner).parameters:
-        return CliRunner(mix_stderr=False)
-    return CliRunner()
 
 
 def run(command, *args):

@@ -2,7 +2,6 @@
 the Solution that ``solve`` returns, equal to an in-process solve; a
 missing or damaged folder named in one clear exception."""
 
-import inspect
 import json
 import shutil
 import tomllib
@@ -13,8 +12,7 @@ import numpy as np
 import pytest
 from adhesive_contact_cli import plots
 from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import glued_contact, scene_dict, to_toml, wall_block
+from conftest import glued_contact, runner, scene_dict, to_toml, wall_block
 
 from adhesive_contact import (
     OutputFolderError,
@@ -46,12 +44,6 @@ FAILING = scene_dict({"solver.max_iter": 1}, wall_block())
 
 ARRAYS = ("t", "u", "beta", "contact_force", "frame_displacement", "on_wall", "stuck",
           "probes", "iterations", "residual", "reaction")
-
-
-def runner():
-    if "mix_stderr" in inspect.signature(CliRunner).parameters:
-        return CliRunner(mix_stderr=False)
-    return CliRunner()
 
 
 def solve_into(folder, text, name="scene.toml"):

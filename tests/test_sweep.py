@@ -3,14 +3,12 @@ settings parsed as TOML values, every variant validated before anything
 runs, failed runs as rows, runs.csv against direct solves, resume."""
 
 import csv
-import inspect
 import shutil
 
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import assert_one_line_error, scene_dict, to_toml, wall_block
+from conftest import assert_one_line_error, runner, scene_dict, to_toml, wall_block
 
 import adhesive_contact.studies.sweep as sweep_module
 from adhesive_contact import (
@@ -29,12 +27,6 @@ SCENE_DICT = wall_block()
 SCENE = to_toml(SCENE_DICT)
 
 GRID = ("--set", "contact.normal.c=1e3,5000", "--set", "solver.max_iter=1,50")
-
-
-def runner():
-    if "mix_stderr" in inspect.signature(CliRunner).parameters:
-        return CliRunner(mix_stderr=False)
-    return CliRunner()
 
 
 def run(*args):

@@ -3,7 +3,6 @@ fall back to "units of length" / "units of E" without them; the figures'
 other fixes (the von Mises label, the β mean, the step curves' ends, the
 3D ticks). Labels are read from the matplotlib figures, not from PNGs."""
 
-import inspect
 import json
 
 import matplotlib.pyplot as plt
@@ -14,8 +13,15 @@ from adhesive_contact_cli import converge as converge_cli
 from adhesive_contact_cli import plots
 from adhesive_contact_cli import sweep as sweep_cli
 from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import assert_one_line_error, glued_contact, prony, scene_dict, to_toml, wall_block
+from conftest import (
+    assert_one_line_error,
+    glued_contact,
+    prony,
+    runner,
+    scene_dict,
+    to_toml,
+    wall_block,
+)
 from matplotlib.patches import StepPatch
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
@@ -174,12 +180,6 @@ def test_the_3d_figures_name_the_units_and_keep_few_ticks(box):
     assert bars == ["normal traction −σ_ν\n(> 0 compression; MPa)"]
     without = labels(figures(box["without"])["deformed"])
     assert without[1, "y"] == "von Mises stress (units of E)"
-
-
-def runner():
-    if "mix_stderr" in inspect.signature(CliRunner).parameters:
-        return CliRunner(mix_stderr=False)
-    return CliRunner()
 
 
 def run(*args):

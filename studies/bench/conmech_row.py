@@ -30,17 +30,15 @@ beside this script and prints the two rows.
 
 import argparse
 import csv
-import datetime
-import os
-import platform
 import resource
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
-from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
+
+from machine import describe  # studies/bench/machine.py, beside this script
 
 HERE = Path(__file__).resolve().parent
 SCENE = HERE / "conmech_setup0.toml"
@@ -92,18 +90,6 @@ def in_process(scene_path, repeats=REPEATS):
             "contact_nodes": int(problem.boundary.nodes.size)}
 
 
-def machine():
-    found = {}
-    for name in ("numpy", "scipy", "scikit-fem", "pypardiso"):
-        try:
-            found[name] = version(name)
-        except PackageNotFoundError:
-            found[name] = None
-    return {"platform": platform.platform(), "processor": platform.processor(),
-            "cpus": os.cpu_count(), "python": platform.python_version(), "versions": found,
-            "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}
-
-
 FIELDS = ("code", "nodes", "dofs", "setup_s", "solve_s", "in_process_s", "process_s",
           "peak_rss_mb", "backend")
 
@@ -121,7 +107,7 @@ def main():
 
     out = Path(args.out)
     write_json(out / "conmech_row.json", {
-        "scene": str(SCENE.relative_to(HERE.parent.parent)), "machine": machine(),
+        "scene": str(SCENE.relative_to(HERE.parent.parent)), "machine": describe(),
         "ours": ours, "conmech_quoted": CONMECH,
         "notes": "setup_s: build_problem + factorisation + Schur complement (factorisation_s: "
                  "the step operators' build, both); solve_s: the "

@@ -38,14 +38,12 @@ beside this script, and prints a table.
 
 import argparse
 import csv
-import datetime
 import math
-import os
-import platform
 import time
 from dataclasses import replace
-from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
+
+from machine import describe  # studies/bench/machine.py, beside this script
 
 HERE = Path(__file__).resolve().parent
 SCENE = HERE.parent / "convergence" / "b_wall_multiplier.toml"
@@ -103,18 +101,6 @@ def points(base, backends):
     # size by size, every choice in turn: a spell of load from other work on
     # the machine then falls on all choices of a size, not on one series
     return sorted(out, key=lambda point: (point[5], point[6]))
-
-
-def machine():
-    found = {}
-    for name in ("numpy", "scipy", "scikit-fem", "pyamg", "pypardiso"):
-        try:
-            found[name] = version(name)
-        except PackageNotFoundError:
-            found[name] = None
-    return {"platform": platform.platform(), "processor": platform.processor(),
-            "cpus": os.cpu_count(), "python": platform.python_version(), "versions": found,
-            "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}
 
 
 FIELDS = ("series", "choice", "linear", "quadrature", "amg_tol", "refine", "cells", "steps",
@@ -225,7 +211,7 @@ def main():
               f"{fmt(row.get('stepping_seconds'), '.3f'):>8}  {row['status']}", flush=True)
     best = cheapest(rows)
     meta = {"scene": str(SCENE.relative_to(HERE.parent.parent)), "target": TARGET,
-            "machine": machine(), "cheapest": best,
+            "machine": describe(), "cheapest": best,
             "total_seconds": time.perf_counter() - t_start,
             "seconds": "run_level's wall time: build_problem + solve (set-up + stepping), "
                        "fastest of 3 runs (of 2 above 1 s); errors excluded"}
