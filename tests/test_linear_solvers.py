@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from scipy.sparse.linalg import cg
+from scipy.sparse.linalg import cg, spsolve
 from skfem import MeshTet, MeshTri
 
 from adhesive_contact.assembly import Assembly, stiffness_basis
@@ -262,3 +262,29 @@ def test_pardiso_releases_its_factors():
     del solver
     gc.collect()
     assert released == [True]
+
+
+def test_amg_reaches_round_off_on_a_slender_cantilever():
+    """A 4 × 0.5 strip clamped at one end and pulled at the other (10400
+    dofs): its condition number puts the round-off of b − A x (ε ‖A‖ ‖x‖,
+    7e-10 ‖b‖) above tol ‖b‖ = 1e-10 ‖b‖, where a direct solve also stops
+    (2.5e-10 ‖b‖). AMG-CG stops there too instead of raising (pyamg's CG
+    restarted from an iterate at round-off diverged, to 1e47), and agrees
+    with the direct solve to the conditioning of the problem."""
+    from conftest import scene_dict
+
+    from adhesive_contact import build_problem, scene_from_dict
+
+    problem = build_problem(scene_from_dict(scene_dict({
+        "mesh.size": [4.0, 0.5], "mesh.cells": [200, 25], "boundary.dirichlet": ["left"],
+        "boundary.contact": [], "loads.traction": {"right": ["7*t", "14*t"]}})))
+    free = problem.free
+    material = problem.scene.material
+    A = problem.assembly.stiffness(material.lam, material.mu)[free][:, free].tocsr()
+    b = problem.loads(0.05)[free]
+    solver = make_linear_solver(A, "amg", dim=2, points=problem.mesh.p, dofs=free)
+    x = solver.solve(b)
+    direct = spsolve(A.tocsc(), b)
+    assert np.linalg.norm(b - A @ direct) > 1e-10 * np.linalg.norm(b)   # the case is one
+    assert solver.info["relative_residual"] <= 1e-9
+    assert np.linalg.norm(x - direct) <= 1e-6 * np.linalg.norm(direct)
