@@ -225,7 +225,7 @@ def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13
     factorisation of a_n = A + D only (:mod:`adhesive_contact.scheme.operators`):
     u⁽ⁱ⁺¹⁾ solves the step with the load b + D u⁽ⁱ⁾, from u⁽⁰⁾ = 0, until
     ‖u⁽ⁱ⁺¹⁾ − u⁽ⁱ⁾‖ ≤ rtol ‖u⁽ⁱ⁺¹⁾‖ (the error is then about
-    ρ/(1 − ρ) of that, ρ ≤ ``contraction`` ≤ 1/2). The returned result
+    ρ/(1 − ρ) of that, ρ ≤ ``contraction`` ≤ 0.3). The returned result
     counts the Newton iterations of all of them; its load c is that of the
     last, so that S z − c is the contact force of the t = 0 problem
     (a_n u − D u = A u). Same returns as :func:`free_solve`."""
@@ -245,7 +245,7 @@ def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13
         u = u_next
         if done:
             return u, z0, c, result
-    if result is None:   # linear: the iteration contracts by ρ < 1/2, so this is reached
+    if result is None:   # linear: the iteration contracts by ρ ≤ 0.3, so this is reached
         return u, z0, c, result
     result = replace(result, status=MAX_ITERATIONS, message=(
         f"the t = 0 iteration on the step matrix did not settle in {limit} step solves "
