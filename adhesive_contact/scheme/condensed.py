@@ -23,6 +23,7 @@ or :class:`ImplicitSchur`, applied only.
 """
 
 import time
+from contextlib import nullcontext
 
 import numpy as np
 import scipy.linalg as la
@@ -30,9 +31,12 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, cg
 
 from ..linear_solvers import SuperLUSolver
+from .threads import all_blas_threads
 
 #: from this size on, a dense Newton system is factorised in single precision
 MIXED_FROM = 1000
+#: and from this size on with all BLAS threads (:mod:`.threads`)
+THREADED_FROM = 2000
 
 
 def dense_solver(H, mixed_from=MIXED_FROM):
@@ -45,7 +49,8 @@ def dense_solver(H, mixed_from=MIXED_FROM):
     iteration at thousands of contact unknowns) and the solution refined to
     double precision by :func:`mixed_precision_solver`."""
     if H.shape[0] >= mixed_from:
-        solve = mixed_precision_solver(H)
+        solve = mixed_precision_solver(H.astype(np.float32), lambda v: H @ v,
+                                       np.abs(np.diag(H)).max(), lambda: H)
         if solve is not None:
             return solve
     try:
@@ -57,7 +62,7 @@ def dense_solver(H, mixed_from=MIXED_FROM):
         return lambda rhs: vecs @ ((vecs.T @ rhs) / vals)
 
 
-def mixed_precision_solver(H, rtol=1e-14, maxiter=30):
+def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
     """Solve H x = b (H symmetric positive definite, double precision) by CG
     on H preconditioned with the Cholesky factor of H in single precision:
     with κ(H) ε₃₂ < 1 the preconditioned matrix has its eigenvalues within
@@ -65,27 +70,36 @@ def mixed_precision_solver(H, rtol=1e-14, maxiter=30):
     ‖b − H x‖ ≤ rtol (max_i H_ii) ‖x‖, in a few products (x from the
     single-precision solve in the bound).
 
+    Parameters
+    ----------
+    H32 : (m, m) float32, H rounded (overwritten by its factor)
+    apply : callable v -> H v in double precision
+    largest : max_i |H_ii|
+    exact : callable () -> H in double precision, for the fallback
+
     Returns None where single precision does not factorise H (H not
     positive definite, or too ill-conditioned); the solver factorises H in
     double precision if CG does not reach rtol in ``maxiter`` products."""
+    m = H32.shape[0]
+    threads = all_blas_threads() if m >= THREADED_FROM else nullcontext()
     try:
-        factor = la.cho_factor(H.astype(np.float32), check_finite=False, overwrite_a=True)
+        with threads:
+            factor = la.cho_factor(H32, check_finite=False, overwrite_a=True)
     except la.LinAlgError:
         return None
-    m = H.shape[0]
     precondition = LinearOperator(
         (m, m), dtype=float,
         matvec=lambda r: la.cho_solve(factor, r.astype(np.float32), check_finite=False))
-
-    scale = rtol * np.abs(np.diag(H)).max()
+    operator = LinearOperator((m, m), dtype=float, matvec=apply)
+    scale = rtol * largest
 
     def solve(rhs):
         start = precondition @ rhs
-        x, info = cg(H, rhs, x0=start, M=precondition, rtol=0.0,
+        x, info = cg(operator, rhs, x0=start, M=precondition, rtol=0.0,
                      atol=scale * np.linalg.norm(start), maxiter=maxiter)
         if info == 0:
             return x
-        return dense_solver(H, mixed_from=np.inf)(rhs)
+        return dense_solver(exact(), mixed_from=np.inf)(rhs)
     return solve
 
 
@@ -95,9 +109,20 @@ class DenseSchur:
     def __init__(self, S):
         self.matrix = S
         self.shape = S.shape
+        self._single = None   # S in single precision, made on first use
+        self._last = (None, None)   # (z, S z) of the last product
 
     def __matmul__(self, z):
-        return self.matrix @ z
+        """S z; the last product is kept, since the step methods ask for S z
+        of the iterate a line search has just tried (an O(m) comparison
+        against an O(m²) product)."""
+        last, product = self._last
+        if last is not None and last.shape == np.shape(z) and np.array_equal(last, z):
+            return product.copy()
+        product = self.matrix @ z
+        if np.ndim(z) == 1:
+            self._last = (np.array(z, copy=True), product.copy())
+        return product
 
     def diagonal(self):
         return np.diag(self.matrix)
@@ -105,12 +130,36 @@ class DenseSchur:
     def newton_solve(self, H_phi, rhs, free):
         """Solve (S + H_φ)_FF d = rhs on the free coordinates F (a boolean
         mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`.
-        Only the entries of H_φ are added to the copy of S_FF."""
+        Only the entries of H_φ are added to the copy of S_FF; from
+        MIXED_FROM free coordinates on, that copy is taken in single
+        precision and the products of the refinement use S itself."""
         idx = np.flatnonzero(free)
-        H = self.matrix.copy() if idx.size == free.size else self.matrix[np.ix_(idx, idx)]
+        everything = idx.size == free.size
         block = sp.coo_matrix(sp.csr_matrix(H_phi)[idx][:, idx])
-        H[block.row, block.col] += block.data
-        return dense_solver(H)(rhs), True
+
+        def exact():
+            H = self.matrix.copy() if everything else self.matrix[np.ix_(idx, idx)]
+            H[block.row, block.col] += block.data
+            return H
+
+        if idx.size >= MIXED_FROM:
+            if self._single is None:
+                self._single = self.matrix.astype(np.float32)
+            H32 = (self._single.copy() if everything
+                   else self._single.take(idx, axis=0).take(idx, axis=1))
+            H32[block.row, block.col] += block.data.astype(np.float32)
+            H_FF = block.tocsr()
+            full = np.zeros(free.size)
+
+            def apply(v):
+                full[idx] = v
+                return (self.matrix @ full)[idx] + H_FF @ v
+
+            largest = np.abs(self.matrix[idx, idx] + H_FF.diagonal()).max()
+            solve = mixed_precision_solver(H32, apply, largest, exact)
+            if solve is not None:
+                return solve(rhs), True
+        return dense_solver(exact(), mixed_from=np.inf)(rhs), True
 
 
 class ImplicitSchur:
