@@ -30,11 +30,25 @@ def gradients(mesh):
     d = p.shape[0]
     J = np.stack([p[:, t[i]] - p[:, t[0]] for i in range(1, d + 1)], axis=-1)  # (d, ne, d)
     J = J.transpose(1, 0, 2)                                                    # (ne, d, d)
-    det = np.linalg.det(J)
-    inv_T = np.linalg.inv(J).transpose(0, 2, 1)                                 # J^{-T}
+    det, inv_T = _det_inverse_transpose(J)                                      # J^{-T}
     ref = np.vstack([-np.ones((1, d)), np.eye(d)])                              # (d+1, d)
     g = np.einsum("eab,ib->eia", inv_T, ref)
     return g, np.abs(det) / factorial(d)
+
+
+def _det_inverse_transpose(J):
+    """det J and J^{-T} for a stack (ne, d, d), d = 2 or 3, by cofactors:
+    J^{-T} = cof(J) / det J (several times faster than LAPACK per 2 × 2)."""
+    d = J.shape[-1]
+    if d == 2:
+        cof = np.stack([np.stack([J[:, 1, 1], -J[:, 1, 0]], -1),
+                        np.stack([-J[:, 0, 1], J[:, 0, 0]], -1)], -2)
+    else:
+        # row i of cof(J) is row i+1 × row i+2 of J (indices mod 3)
+        r0, r1, r2 = J[:, 0, :], J[:, 1, :], J[:, 2, :]
+        cof = np.stack([np.cross(r1, r2), np.cross(r2, r0), np.cross(r0, r1)], -2)
+    det = np.einsum("ea,ea->e", J[:, 0, :], cof[:, 0, :])
+    return det, cof / det[:, None, None]
 
 
 def element_dofs(mesh):
@@ -44,31 +58,57 @@ def element_dofs(mesh):
     return (d * mesh.t.T[:, :, None] + np.arange(d)[None, None, :]).reshape(mesh.t.shape[1], -1)
 
 
+def node_pattern(mesh):
+    """The sparsity of P1 on the nodes: every pair of vertices of a cell.
+
+    Returns ``(indptr, indices, slot)``: the CSR pattern (n_nodes rows,
+    sorted columns) and, for each pair (e, i, j) in C order of (cell, local
+    vertex i, local vertex j), its position in ``indices``."""
+    t = mesh.t
+    nv, ne = t.shape
+    n = mesh.p.shape[1]
+    cells = t.T.astype(np.int64)
+    key = (cells[:, :, None] * n + cells[:, None, :]).ravel()
+    unique, slot = np.unique(key, return_inverse=True)   # sorted: row-major order
+    indptr = np.searchsorted(unique, np.arange(n + 1, dtype=np.int64) * n)
+    return indptr, (unique % n).astype(np.int32 if n < 2**31 else np.int64), slot.ravel()
+
+
+def assemble_blocks(pattern, component, d):
+    """A CSR matrix of vector P1 summed into the node pattern of
+    :func:`node_pattern`: ``component(a, b)`` gives the (ne, nv, nv) entries
+    of the element matrices between the dofs d·node_i + a and d·node_j + b;
+    each component is summed over the cells by one bincount, into the d × d
+    blocks of a block (BSR) matrix."""
+    indptr, indices, slot = pattern
+    nnzb = indices.size
+    data = np.empty((nnzb, d, d))
+    for a in range(d):
+        for b in range(d):
+            data[:, a, b] = np.bincount(slot, weights=component(a, b).ravel(), minlength=nnzb)
+    n = (indptr.size - 1) * d
+    return sp.bsr_matrix((data, indices, indptr), shape=(n, n)).tocsr()
+
+
 def stiffness_parts(mesh):
     """(K_λ, K_μ): ∫ div u div v and ∫ 2 ε(u):ε(v) for vector P1, CSR.
 
-    Both share one sparsity pattern, so they go through one sparse
-    conversion: the element matrices as the real and imaginary parts of one
-    complex array (the duplicates of each part are summed separately)."""
+    Both are summed into the one node pattern of :func:`node_pattern`, a
+    component (a, b) at a time (:func:`assemble_blocks`)."""
     g, vol = gradients(mesh)
-    ne, nv, d = g.shape
-    n, m = d * mesh.p.shape[1], nv * d
-    flat = g.reshape(ne, m)
-    # K_λ: |e| g_i[a] g_j[b]
-    local = (vol[:, None, None] * flat[:, :, None] * flat[:, None, :]).astype(complex)
-    # K_μ: |e| (δ_ab g_i·g_j + g_i[b] g_j[a]), local index (i, a) × (j, b)
-    G = np.einsum("eia,eja->eij", g, g)
-    mu = G[:, :, None, :, None] * np.eye(d)[None, None, :, None, :]
-    mu += g[:, :, None, None, :] * g.transpose(0, 2, 1)[:, None, :, :, None]
-    local.imag = vol[:, None, None] * mu.reshape(ne, m, m)
-    dofs = element_dofs(mesh).astype(np.int32 if n < 2**31 else np.int64)
-    rows = np.broadcast_to(dofs[:, :, None], (ne, m, m)).ravel()
-    cols = np.broadcast_to(dofs[:, None, :], (ne, m, m)).ravel()
-    K = sp.coo_matrix((local.ravel(), (rows, cols)), shape=(n, n)).tocsr()
-    K.sum_duplicates()
-    real = sp.csr_matrix((K.data.real.copy(), K.indices, K.indptr), shape=(n, n))
-    imag = sp.csr_matrix((K.data.imag.copy(), K.indices, K.indptr), shape=(n, n))
-    return real, imag
+    d = g.shape[2]
+    gv = g * vol[:, None, None]                       # |e| g_i
+    G = np.einsum("eia,eja->eij", gv, g)              # |e| g_i·g_j
+
+    def lam(a, b):   # |e| g_i[a] g_j[b]
+        return gv[:, :, None, a] * g[:, None, :, b]
+
+    def mu(a, b):    # |e| (δ_ab g_i·g_j + g_i[b] g_j[a])
+        out = gv[:, :, None, b] * g[:, None, :, a]
+        return out + G if a == b else out
+
+    pattern = node_pattern(mesh)
+    return assemble_blocks(pattern, lam, d), assemble_blocks(pattern, mu, d)
 
 
 def strain_operator(mesh):
@@ -78,11 +118,15 @@ def strain_operator(mesh):
     eye = np.eye(d)
     # ε_bc of u = φ_i e_a: ½ (δ_ab g_i[c] + δ_ac g_i[b]), indexed (e, b, c, i, a)
     eps = 0.5 * (np.einsum("ab,eic->ebcia", eye, g) + np.einsum("ac,eib->ebcia", eye, g))
-    rows = np.broadcast_to(np.arange(ne * d * d).reshape(ne, d * d, 1), (ne, d * d, nv * d))
-    cols = np.broadcast_to(element_dofs(mesh)[:, None, :], (ne, d * d, nv * d))
-    B = sp.csr_matrix((eps.reshape(ne, d * d, nv * d).ravel(), (rows.ravel(), cols.ravel())),
+    # row (e, b, c) holds the (d+1)·d dofs of cell e once each: CSR directly
+    nnz = ne * d * d * nv * d
+    index = np.int32 if max(nnz, d * mesh.p.shape[1]) < 2**31 else np.int64
+    cols = np.broadcast_to(element_dofs(mesh).astype(index)[:, None, :], (ne, d * d, nv * d))
+    indptr = np.arange(0, nnz + 1, nv * d, dtype=index)
+    B = sp.csr_matrix((eps.reshape(-1), cols.reshape(-1), indptr),
                       shape=(ne * d * d, d * mesh.p.shape[1]))
     B.eliminate_zeros()
+    B.sort_indices()
     return B
 
 

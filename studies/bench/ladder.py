@@ -153,34 +153,54 @@ def write(rows, exponents):
         {"machine": machine, "rows": rows, "growth": exponents}, indent=1))
     os.replace(HERE / "ladder.json.tmp", HERE / "ladder.json")
 
+    plot(rows, machine)
+
+
+COLOURS = {"frictionless": "tab:blue", "full": "tab:red", "elastic": "0.45"}
+STYLES = {"pardiso": ("o", "-"), "superlu": ("s", "--"), "amg": ("^", ":")}
+
+
+def plot(rows, machine):
+    """ladder.png: set-up, one step and a step in solve pairs against the
+    dofs, 2D above and 3D below; colour the model, marker the backend."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
+    from matplotlib.lines import Line2D
+
+    fig, axes = plt.subplots(2, 3, figsize=(15, 8.2), layout="constrained")
     for (dim, model, backend), group in _groups(rows).items():
         dofs = [r["dofs"] for r in group]
-        label = f"{dim}D {model}, {backend}"
-        style = "o-" if model == "full" else "s--"
-        axes[0].loglog(dofs, [r["setup"] for r in group], style, label=label)
-        axes[1].loglog(dofs, [r["per_step"] for r in group], style, label=label)
-        axes[2].semilogx(dofs, [r["pairs_per_step"] for r in group], style, label=label)
-    for ax, title, ylabel in zip(axes, ["set-up (factorisation + Schur)", "one step",
-                                        "a step in solve pairs"],
-                                 ["seconds", "seconds", "per_step / solve pair"]):
-        ax.set(title=title, xlabel="dofs", ylabel=ylabel)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=7)
+        marker, line = STYLES.get(backend, ("x", "-."))
+        style = {"marker": marker, "linestyle": line, "color": COLOURS.get(model, "k")}
+        row = axes[dim - 2]
+        row[0].loglog(dofs, [r["setup"] for r in group], **style)
+        row[1].loglog(dofs, [r["per_step"] for r in group], **style)
+        row[2].semilogx(dofs, [r["pairs_per_step"] for r in group], **style)
+    for dim, row in zip((2, 3), axes):
+        for ax, title, ylabel in zip(row, ["set-up (factorisation + Schur)", "one step",
+                                           "a step in solve pairs"],
+                                     ["seconds", "seconds", "per step / solve pair"]):
+            ax.set(title=f"{dim}D: {title}", xlabel="dofs", ylabel=ylabel)
+            ax.grid(True, which="both", alpha=0.3)
+        row[2].set_yscale("log")
+    handles = ([Line2D([], [], color=c, label=m) for m, c in COLOURS.items()]
+               + [Line2D([], [], color="k", marker=mk, linestyle=ls, label=b)
+                  for b, (mk, ls) in STYLES.items()])
+    fig.legend(handles=handles, loc="outside right center", fontsize=9)
     fig.suptitle(f"ladder: {STEPS} steps per case, {machine['cpus']} cores")
-    fig.tight_layout()
-    fig.savefig(HERE / "ladder.tmp.png", dpi=110)
+    fig.savefig(HERE / "ladder.tmp.png", dpi=100)
     os.replace(HERE / "ladder.tmp.png", HERE / "ladder.png")
 
 
 def _groups(rows):
+    """Rows by (dim, model, backend), one per size (the first: "auto" and
+    the backend it picked give the same case)."""
     out = {}
     for r in rows:
-        out.setdefault((r["dim"], r["model"], r["backend"]), []).append(r)
-    return out
+        group = out.setdefault((r["dim"], r["model"], r["backend"]), {})
+        group.setdefault(r["dofs"], r)
+    return {key: [group[n] for n in sorted(group)] for key, group in out.items()}
 
 
 def main():
@@ -188,7 +208,13 @@ def main():
     parser.add_argument("--max-dofs", type=float, default=1.1e6)
     parser.add_argument("--backends", default="auto")
     parser.add_argument("--case", help=argparse.SUPPRESS)   # one case, in a child process
+    parser.add_argument("--replot", action="store_true",
+                        help="redraw ladder.png from ladder.json without running")
     args = parser.parse_args()
+    if args.replot:
+        document = json.loads((HERE / "ladder.json").read_text())
+        plot(document["rows"], document["machine"])
+        return
     if args.case:
         print(json.dumps(run_case(json.loads(args.case))))
         return
