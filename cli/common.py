@@ -9,6 +9,7 @@ any output, so a bad scene exits 2 with one line and writes nothing.
 
 import os
 import tomllib
+from contextlib import contextmanager
 from importlib import resources
 from pathlib import Path
 
@@ -137,3 +138,22 @@ def echo_warnings(problem):
     """One line ``warning: ...`` on stderr per thing the theory does not cover."""
     for warning in problem.warnings():
         click.echo(f"warning: {' '.join(str(warning).split())}", err=True)
+
+
+@contextmanager
+def running_study(out, executor, saved):
+    """Run a study's block: a lost scheduler or an unwritable ``out`` is a
+    CliError (exit 1) saying the finished ``saved`` ("runs", "levels") are
+    kept; the executor is closed whatever happens."""
+    from adhesive_contact.studies.executors import ClusterError
+
+    try:
+        yield
+    except ClusterError as err:
+        raise CliError(f"--scheduler {err.address}: {err.message}; the finished {saved} are "
+                       "saved, the same command resumes", 1) from None
+    except OSError as err:
+        raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+    finally:
+        if executor is not None:
+            executor.close()

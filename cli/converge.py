@@ -25,7 +25,6 @@ from adhesive_contact.studies import (
     RunFailed,
 )
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
-from adhesive_contact.studies.executors import ClusterError
 
 from .common import (
     CliError,
@@ -35,6 +34,7 @@ from .common import (
     load_scene,
     open_study,
     read_scene,
+    running_study,
     scene_folder,
     study_source,
 )
@@ -299,20 +299,14 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
 
     bars = Progress(name, study)
     try:
-        result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
-        files = result.files + write_plots(out, result.document, study.scene.title,
-                                           study.scene.units)
+        with running_study(out, executor, "levels"):
+            result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
+            files = result.files + write_plots(out, result.document, study.scene.title,
+                                               study.scene.units)
     except RunFailed as err:
         raise CliError(str(err), 1) from None
-    except ClusterError as err:
-        raise CliError(f"--scheduler {err.address}: {err.message}; the finished levels are "
-                       "saved, the same command resumes", 1) from None
-    except OSError as err:
-        raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
     finally:
         bars.close()
-        if executor is not None:
-            executor.close()
 
     document = result.document
     computed = len(result.computed)

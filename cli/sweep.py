@@ -20,16 +20,15 @@ from adhesive_contact.studies import (
     Sweep,
     parse_assignment,
 )
-from adhesive_contact.studies.executors import ClusterError
 from adhesive_contact.studies.sweep import LOST, show, variant_document, variants
 
 from .common import (
-    CliError,
     check_out,
     guard,
     load_scene,
     open_study,
     read_scene,
+    running_study,
     scene_folder,
     study_source,
 )
@@ -219,21 +218,13 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
                            label=f"{name}: sweep of {total} runs") as bar:
         def progress(stage, done, total):
             bar.update(done - bar.pos)
-        try:
+        with running_study(out, executor, "runs"):
             result = study.run(jobs=jobs or 1, executor=executor, progress=progress)
             files = list(result.files)
             for key in keys:
                 files.append(plot_name(key))
                 plot_key(out / files[-1], result.rows, keys, key, study.base.title,
                          Units(study.base.units), study.base.dim)
-        except ClusterError as err:
-            raise CliError(f"--scheduler {err.address}: {err.message}; the finished runs are "
-                           "saved, the same command resumes", 1) from None
-        except OSError as err:
-            raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
-        finally:
-            if executor is not None:
-                executor.close()
 
     failed = sum(row["outcome"] == "failed" for row in result.rows)
     lost = len(result.lost)
