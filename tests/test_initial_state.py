@@ -68,3 +68,27 @@ def test_contraction_bounds_the_spectral_radius(dim):
     assert 0.0 < bound < 1.0
     assert rho <= bound * (1 + 1e-10)
     assert rho >= 0.9 * bound
+
+
+def test_a_proximal_iteration_that_does_not_settle_is_a_failed_step():
+    """Told a contraction far below the true one, the t = 0 iteration runs
+    out of its 14 solves (ρ ≈ 0.27 needs about 25) and the step fails with
+    what it reached and what to try, not with an unconverged u."""
+    from adhesive_contact.scheme.state import ContactStep, initial_state, proximal_solve, step_load
+    from adhesive_contact.step_methods import MAX_ITERATIONS
+
+    problem = build_problem(scene_from_dict(scene_dict({**CHANGES,
+                                                        "memory": prony((1200.0, 0.3, 0.2))})))
+    memory = problem.start_memory()
+    operators = StepOperators.build(problem, memory)
+    assert operators.shift is not None and 0.2 < operators.contraction <= 0.3
+    state = initial_state(problem, memory)
+    b, _ = step_load(problem, operators, state, 0, 0.0)
+    contact = ContactStep(problem)
+    args = (operators.step, operators.shift, contact, 0, b, problem.beta0, state.z)
+    u, *_, result = proximal_solve(*args, contraction=operators.contraction)
+    assert u is not None and result.success
+    u, *_, result = proximal_solve(*args, contraction=1e-3)
+    assert u is None and result.status == MAX_ITERATIONS
+    assert "did not settle in 14 step solves" in result.message
+    assert "try a smaller time step" in result.message

@@ -245,7 +245,9 @@ def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13
         u = u_next
         if done:
             return u, z0, c, result
-    if result is None:   # linear: the iteration contracts by ρ ≤ 0.3, so this is reached
+    if result is None:
+        # no contact terms: a linear iteration contracting by ρ ≤ 0.3, which
+        # only round-off can keep from rtol; its last iterate is as good
         return u, z0, c, result
     result = replace(result, status=MAX_ITERATIONS, message=(
         f"the t = 0 iteration on the step matrix did not settle in {limit} step solves "
