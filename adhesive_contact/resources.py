@@ -13,10 +13,11 @@ and estimates
   matrices of the step matrix's pattern), the factors of the step matrix
   (:func:`~adhesive_contact.linear_solvers.factor_bytes`; about three
   copies of the pattern for AMG), the dense Schur complement on the
-  contact unknowns (m² doubles), and what grows with the steps: u at every
-  level (kept for the outputs; a second copy for a function kernel's
-  history sum), β per contact facet and the gap per contact node at every
-  level;
+  contact unknowns (m² doubles, and from 1000 unknowns on its single
+  precision copy and two of a Newton system's), and what grows with the
+  steps: u at every level (kept for the outputs; a second copy for a
+  function kernel's history sum), β per contact facet and the gap per
+  contact node at every level;
 - time: the set-up (assembly and factorisation) and N steps, each two
   solves with the factors plus a few dense Newton solves on the contact
   unknowns (and, for a function kernel, a history sum over all previous
@@ -44,17 +45,29 @@ PATTERN = {2: 7, 3: 15}
 CELLS_PER_BLOCK = {("rectangle", "diagonal"): 2, ("rectangle", "cross"): 4,
                    ("box", "diagonal"): 6}
 BYTES_PER_ENTRY = 12          # a double and an index of a sparse entry
-#: measured on this code (one core, PARDISO): about 1.2 µs per dof for the
-#: two solves of a step at 1e5 dofs and 12 µs per dof of set-up; rounded up
+#: measured on this code (PARDISO, studies/bench/ladder.py): about 1.2 µs
+#: per dof for the two solves of a step at 1e5 dofs; set-up (assembly and
+#: factorisation) 10–15 µs per dof in 2D (1e5–1e6 dofs), 35 µs at 1e4 and
+#: 70 µs at 1.1e5 in 3D, where a factorisation's work per dof grows (the
+#: ladder fits set-up ~ n^1.24–1.5): rounded up, the 3D one grown like
+#: n^(1/3) from 1e5 dofs
 SECONDS_PER_DOF_STEP = 2e-6
-SECONDS_PER_DOF_SETUP = 2e-5
+SECONDS_PER_DOF_SETUP = {2: 3e-5, 3: 1.5e-4}
+SETUP_GROWTH = {2: 0.0, 3: 1.0 / 3.0}
 SECONDS_PER_STEP = 5e-3       # the Python work of a step and its Newton iterations
-FLOPS = 2e9                   # dense Newton solves on the contact unknowns
+#: dense Newton solves on the contact unknowns: measured 1.3e11 (2D, 4000
+#: unknowns) to 2.3e11 (3D, 6336) flop/s in effect, in single precision on
+#: two threads (studies/bench/ladder.py); a tenth of that, since a step
+#: takes up to 13 iterations against the NEWTON_ITERATIONS counted
+FLOPS = 2e10
 #: the process with its libraries loaded, and the working memory of assembly
 #: per dof (mesh, quadrature arrays, boundary): measured peak resident memory
 #: 100 MB at 1e3 dofs, 270–470 MB at 2.6e4–6.6e4 dofs (2D, PARDISO)
 BASE_BYTES = 150e6
 BYTES_PER_DOF = 4000
+#: bytes per m² of the dense Schur complement S (8), its single-precision
+#: copy (4) and the two single-precision copies a Newton system takes (8)
+DENSE_BYTES = 20
 NEWTON_ITERATIONS = 5         # per step, for the dense part of the estimate
 DAY = 86400.0
 
@@ -154,10 +167,11 @@ def estimate(scene, memory_limit=None):
                else factor_bytes(dofs, nnz, d, backend))
     history = 8.0 * levels * (dofs * (2 if _function_kernel(scene) else 1) + 2 * contact_nodes)
     memory = (BASE_BYTES + BYTES_PER_DOF * dofs + 4 * BYTES_PER_ENTRY * nnz + factors
-              + 8.0 * unknowns**2 + history)
+              + DENSE_BYTES * unknowns**2 + history)
     step = (SECONDS_PER_STEP + SECONDS_PER_DOF_STEP * dofs + NEWTON_ITERATIONS * unknowns**3 / (3 * FLOPS)
             + (1e-9 * dofs * levels / 2 if _function_kernel(scene) else 0.0))
-    seconds = SECONDS_PER_DOF_SETUP * dofs + unknowns**3 / FLOPS + levels * step
+    setup = SECONDS_PER_DOF_SETUP[d] * dofs * max(1.0, dofs / 1e5) ** SETUP_GROWTH[d]
+    seconds = setup + unknowns**3 / FLOPS + levels * step
     disk = 8.0 * levels * (2 * dofs + 10 * cells)
     return Estimate(nodes, dofs, cells, contact_nodes, unknowns, levels, backend, reason,
                     float(memory), float(seconds), float(disk))

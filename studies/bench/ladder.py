@@ -15,7 +15,9 @@ is its own) and records:
   partial factorisation, two solves with A_II otherwise), and
   ``pairs_per_step`` = per_step / solve_pair: what a step costs in units of
   its unavoidable linear work;
-- ``newton_per_step``; ``peak_mib``: the process's peak resident memory.
+- ``newton_per_step``; ``peak_mib``: the process's peak resident memory;
+- ``estimate_seconds``, ``estimate_mib``: what
+  :func:`adhesive_contact.resources.estimate` predicted from the scene.
 
 It writes ``ladder.csv``, ``ladder.json`` (with the machine) and
 ``ladder.png`` beside this script, and prints the fitted growth exponents
@@ -99,10 +101,13 @@ def scene(dim, m, model, backend):
 def run_case(doc):
     """One case, in this process: the record of the module docstring."""
     from adhesive_contact import build_problem, scene_from_dict, solve
+    from adhesive_contact.resources import estimate
     from adhesive_contact.scheme.operators import StepOperators
 
+    scene = scene_from_dict(doc)
+    guess = estimate(scene)
     t0 = time.perf_counter()
-    problem = build_problem(scene_from_dict(doc))
+    problem = build_problem(scene)
     assembly = time.perf_counter() - t0
     solution = solve(problem)
     total = time.perf_counter() - t0
@@ -130,6 +135,9 @@ def run_case(doc):
         "pairs_per_step": per_step / float(np.median(pairs)),
         "newton_per_step": float(solution.iterations[1:].mean()) if solution.t.size > 1 else 0.0,
         "peak_mib": peak,
+        # adhesive_contact.resources' estimate from the scene alone, which a
+        # run must not exceed by much (it refuses runs beyond the machine)
+        "estimate_seconds": guess.seconds, "estimate_mib": guess.memory_bytes / 2**20,
     }
 
 
