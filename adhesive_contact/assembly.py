@@ -26,7 +26,7 @@ from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
 
 from .expressions import coordinates
-from .p1 import cell_load_map, stiffness_parts, strain_operator
+from .p1 import cell_load_map, gradients, stiffness_parts, strain_operator
 
 
 @BilinearForm
@@ -157,8 +157,9 @@ class Assembly:
     def __init__(self, mesh):
         self.mesh = mesh
         self.dim = mesh.dim()
-        self.K_lam, self.K_mu = stiffness_parts(mesh)
-        self.strain = strain_operator(mesh)
+        geometry = gradients(mesh)   # the barycentric gradients, shared
+        self.K_lam, self.K_mu = stiffness_parts(mesh, geometry)
+        self.strain = strain_operator(mesh, geometry)
 
     @property
     def ndofs(self):

@@ -90,12 +90,13 @@ def assemble_blocks(pattern, component, d):
     return sp.bsr_matrix((data, indices, indptr), shape=(n, n)).tocsr()
 
 
-def stiffness_parts(mesh):
+def stiffness_parts(mesh, geometry=None):
     """(K_λ, K_μ): ∫ div u div v and ∫ 2 ε(u):ε(v) for vector P1, CSR.
 
     Both are summed into the one node pattern of :func:`node_pattern`, a
-    component (a, b) at a time (:func:`assemble_blocks`)."""
-    g, vol = gradients(mesh)
+    component (a, b) at a time (:func:`assemble_blocks`). ``geometry`` is
+    :func:`gradients` of the mesh when the caller has it already."""
+    g, vol = geometry or gradients(mesh)
     d = g.shape[2]
     gv = g * vol[:, None, None]                       # |e| g_i
     G = np.einsum("eia,eja->eij", gv, g)              # |e| g_i·g_j
@@ -111,9 +112,10 @@ def stiffness_parts(mesh):
     return assemble_blocks(pattern, lam, d), assemble_blocks(pattern, mu, d)
 
 
-def strain_operator(mesh):
-    """Sparse B (ne·d·d, ndofs): (B u) reshaped (ne, d, d) is ε(u) per cell."""
-    g, _ = gradients(mesh)
+def strain_operator(mesh, geometry=None):
+    """Sparse B (ne·d·d, ndofs): (B u) reshaped (ne, d, d) is ε(u) per cell
+    (``geometry`` as for :func:`stiffness_parts`)."""
+    g, _ = geometry or gradients(mesh)
     ne, nv, d = g.shape
     eye = np.eye(d)
     # ε_bc of u = φ_i e_a: ½ (δ_ab g_i[c] + δ_ac g_i[b]), indexed (e, b, c, i, a)

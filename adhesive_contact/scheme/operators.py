@@ -91,13 +91,15 @@ class StepOperators:
             A = assembly.stiffness(lam, mu)
             return (R.T @ A @ R).tocsr() if R is not None else A
 
-        def condensed(lam, mu, approximation=None):
+        def coupled(lam, mu):
+            """The matrix of (λ, μ) in frames, its coupling and held rows kept."""
             A = frames(lam, mu)
             rows = A[fixed]     # the held dofs are not rotated: rows of a_n in Cartesian u
             support[(lam, mu)] = (rows[:, free].T.tocsr(), rows)
-            if approximation is False:   # the coupling alone
-                return None
-            A = A[free][:, free]
+            return A
+
+        def condensed(lam, mu, approximation=None):
+            A = coupled(lam, mu)[free][:, free]
             if method == "pardiso" and contact.size:   # S and the solve halves in one
                 operator = PartialCondensation(A, contact)
                 operator.solver.reason = reason
@@ -114,7 +116,7 @@ class StepOperators:
         if (dlam, dmu) != (0.0, 0.0):
             rho = contraction(elastic, (dlam, dmu), problem.dim)
             if rho <= PROXIMAL_UP_TO:   # t = 0 by the proximal iteration on a_n's factors
-                condensed(*elastic, approximation=False)
+                coupled(*elastic)
                 shift = frames(dlam, dmu)[free][:, free]
             else:   # with PARDISO the t = 0 operator forms S as cheaply as it applies it
                 approximation = (None if isinstance(step, PartialCondensation)
