@@ -124,12 +124,14 @@ class AMGSolver(LinearSolver):
         x = np.zeros_like(b)
         r, norm_r = b, norm_b
         iterations = 0
+        def bound(x):   # the class doc's: tol ‖b‖ + the round-off of b − A x
+            return self.tol * norm_b + 10 * np.finfo(float).eps * self.norm_A * np.linalg.norm(x)
+
         while iterations < self.maxiter:
-            bound = self.tol * norm_b + 10 * np.finfo(float).eps * self.norm_A * np.linalg.norm(x)
-            if norm_r <= bound:
+            if norm_r <= bound(x):
                 return x, iterations, norm_r / norm_b if norm_b else 0.0, True
             history = []
-            x = x + self.ml.solve(r, tol=min(bound / norm_r, 0.5),
+            x = x + self.ml.solve(r, tol=min(bound(x) / norm_r, 0.5),
                                   maxiter=self.maxiter - iterations, accel="cg",
                                   residuals=history)
             iterations += max(len(history) - 1, 1)
@@ -137,8 +139,7 @@ class AMGSolver(LinearSolver):
             norm_r, last = np.linalg.norm(r), norm_r
             if norm_r > 0.5 * last:   # stagnation: round-off, or CG gone astray
                 break
-        bound = self.tol * norm_b + 10 * np.finfo(float).eps * self.norm_A * np.linalg.norm(x)
-        return x, iterations, norm_r / norm_b, norm_r <= bound
+        return x, iterations, norm_r / norm_b, norm_r <= bound(x)
 
     def _solve(self, B):
         X = np.empty_like(B)

@@ -11,8 +11,9 @@ default; inside the loop, a dense factorisation of thousands of contact
 unknowns takes all cores again (:func:`all_blas_threads`): a single-precision
 Cholesky of 6336 unknowns took 1.07 s on one thread and 0.66 s on two
 here, 1.08 and 1.29 s with the other core busy (0.28 and 0.19 s at 4000,
-equal at 2000 with a busy core, slower on two below 1000). One controller is inspected once per process (entering its
-limit costs about 30 µs, against 1.4 ms for a fresh ``threadpool_limits``).
+equal at 2000 with a busy core, slower on two below 1000). One controller
+is inspected once per process (entering its limit costs about 30 µs,
+against 1.4 ms for a fresh ``threadpool_limits``).
 """
 
 from functools import lru_cache
