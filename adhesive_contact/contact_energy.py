@@ -28,15 +28,32 @@ class ContactEnergy:
         the step solves for
     normal_law, friction : laws (friction a FrictionSum or None)
     beta : (nf,) β per contact facet
+    within : (positions, size), optional
+        Φ as a function of a longer vector (the free dofs,
+        :mod:`adhesive_contact.scheme.full_system`) that holds the unknowns
+        at ``positions``; by default the vector is the unknowns alone.
+
+    Attributes
+    ----------
+    unknowns : (nz,) int, where the contact unknowns are in the vector
     """
 
-    def __init__(self, boundary, columns, normal_law, friction, beta):
+    def __init__(self, boundary, columns, normal_law, friction, beta, within=None):
         self.boundary = boundary
         self.w = boundary.weights
-        self.N = boundary.normal_trace[:, columns].tocsr()
+        positions, size = within if within is not None else (np.arange(columns.size),
+                                                            columns.size)
+        self.unknowns = np.asarray(positions, dtype=np.int64)
+
+        def trace(t):   # t restricted to the unknowns, as a map from the vector
+            t = t[:, columns].tocsr()
+            return sp.csr_matrix((t.data, self.unknowns[t.indices], t.indptr),
+                                 shape=(t.shape[0], size))
+
+        self.N = trace(boundary.normal_trace)
         self.normal_law = normal_law
         self.friction = friction
-        self.T = ([t[:, columns].tocsr() for t in boundary.tangential_trace]
+        self.T = ([trace(t) for t in boundary.tangential_trace]
                   if friction is not None else [])
         if self.T:
             # all tangential traces stacked (m·nq, nz), and the positions of
@@ -46,7 +63,7 @@ class ContactEnergy:
             q = np.arange(nq)
             self.block_rows = (np.arange(m)[:, None, None] * nq + q).repeat(m, axis=1)
             self.block_cols = (np.arange(m)[None, :, None] * nq + q).repeat(m, axis=0)
-        self.nz = columns.size
+        self.nz = size
         self.set_bonding(beta)
 
     def set_bonding(self, beta):

@@ -21,7 +21,9 @@ and estimates
 - time: the set-up (assembly and factorisation) and N steps, each two
   solves with the factors plus a few dense Newton solves on the contact
   unknowns (and, for a function kernel, a history sum over all previous
-  levels);
+  levels); with AMG and contact, where the Newton systems are those of
+  all free dofs, the hierarchy and a cost per dof and step measured on
+  the benchmark;
 - disk: the outputs (u and the cell stress per level in solution.h5, u
   in solution.npz).
 
@@ -55,8 +57,15 @@ SECONDS_PER_DOF_STEP = 2e-6
 SECONDS_PER_DOF_SETUP = {2: 3e-5, 3: 1.5e-4}
 SETUP_GROWTH = {2: 0.0, 3: 1.0 / 3.0}
 #: seconds per dof and contact unknown of forming S with AMG-CG (measured
-#: 3.3–3.6e-6 at 1e4 dofs, 2D and 3D), rounded up
+#: 3.3–3.6e-6 at 1e4 dofs, 2D and 3D), rounded up: for the "optimizer"
+#: step method, the one that needs S with AMG
 AMG_SCHUR_SECONDS = 1e-5
+#: AMG with contact (Newton on all free dofs, adhesive_contact.scheme.full_system),
+#: measured on the 3D full model of studies/bench/ladder.py: set-up (assembly
+#: and hierarchy) 5.2e-5 s per dof at 1e6 dofs; a step 2.1e-5 s per dof at
+#: 1.1e5 dofs and 3e-5 at 1e6 (12–20 Newton iterations a step); rounded up
+AMG_SECONDS_PER_DOF_SETUP = 1e-4
+AMG_SECONDS_PER_DOF_STEP = 4e-5
 SECONDS_PER_STEP = 5e-3       # the Python work of a step and its Newton iterations
 #: dense Newton solves on the contact unknowns: measured 1.3e11 (2D, 4000
 #: unknowns) to 2.3e11 (3D, 6336) flop/s in effect, in single precision on
@@ -165,19 +174,27 @@ def estimate(scene, memory_limit=None):
     levels = scene.steps + 1
     backend = scene.solver.linear
     reason = f"method {backend!r} was asked for."
+    newton = 0 if scene.solver.method == "optimizer" else unknowns
     if backend == "auto":
-        backend, reason = choose(dofs, nnz, d, memory_limit)
-    factors = (3 * BYTES_PER_ENTRY * nnz if backend == "amg"
+        backend, reason = choose(dofs, nnz, d, memory_limit, contact_unknowns=newton)
+    # with AMG and contact, Newton on all free dofs: no dense S (the hierarchy
+    # and the copies of its level matrices that the contact terms update)
+    full_system = backend == "amg" and newton > 0
+    dense = 0 if full_system else unknowns
+    factors = ((5 if full_system else 3) * BYTES_PER_ENTRY * nnz if backend == "amg"
                else factor_bytes(dofs, nnz, d, backend))
     history = 8.0 * levels * (dofs * (2 if _function_kernel(scene) else 1) + 2 * contact_nodes)
     memory = (BASE_BYTES + BYTES_PER_DOF * dofs + 4 * BYTES_PER_ENTRY * nnz + factors
-              + DENSE_BYTES * unknowns**2 + history)
-    step = (SECONDS_PER_STEP + SECONDS_PER_DOF_STEP * dofs + NEWTON_ITERATIONS * unknowns**3 / (3 * FLOPS)
+              + DENSE_BYTES * dense**2 + history)
+    step = (SECONDS_PER_STEP + SECONDS_PER_DOF_STEP * dofs + NEWTON_ITERATIONS * dense**3 / (3 * FLOPS)
             + (1e-9 * dofs * levels / 2 if _function_kernel(scene) else 0.0))
     setup = SECONDS_PER_DOF_SETUP[d] * dofs * max(1.0, dofs / 1e5) ** SETUP_GROWTH[d]
-    if backend == "amg":   # S formed by one AMG-CG solve per contact unknown
+    if full_system:
+        setup = AMG_SECONDS_PER_DOF_SETUP * dofs
+        step += AMG_SECONDS_PER_DOF_STEP * dofs
+    elif backend == "amg":   # S formed by one AMG-CG solve per contact unknown
         setup += AMG_SCHUR_SECONDS * dofs * unknowns
-    seconds = setup + unknowns**3 / FLOPS + levels * step
+    seconds = setup + dense**3 / FLOPS + levels * step
     disk = 8.0 * levels * (2 * dofs + 10 * cells)
     return Estimate(nodes, dofs, cells, contact_nodes, unknowns, levels, backend, reason,
                     float(memory), float(seconds), float(disk))

@@ -1,9 +1,10 @@
 """Every linear backend gives the scheme the same solution: the full model
 (memory, adhesion, slip weakening, bonding, wall) in 2D and 3D run with
 SuperLU, PARDISO (where installed) and AMG-CG. Direct backends agree to
-round-off amplified by the Newton iterations (1e-9 relative); AMG solves
-each column of the Schur complement to a relative residual of 1e-10, and
-its solutions agree to 1e-7."""
+round-off amplified by the Newton iterations (1e-9 relative); with AMG the
+step method iterates on all free dofs (adhesive_contact.scheme.full_system)
+and stops at the same tolerance on the same pseudo-gradient, so its runs
+agree to that too (measured: 3e-12 in 2D)."""
 
 from dataclasses import replace
 
@@ -43,10 +44,9 @@ def test_backends_give_the_same_run(dim):
     ref = runs["superlu"]
     assert ref.beta[-1].min() < 0.9   # the glue is breaking: the nonlinear terms are at work
     for backend, run in runs.items():
-        tol = 1e-7 if backend == "amg" else 1e-9
         for key in ("u", "beta", "contact_force"):
             a, b = getattr(run, key), getattr(ref, key)
-            assert np.abs(a - b).max() <= tol * np.abs(b).max(), (backend, key)
+            assert np.abs(a - b).max() <= 1e-9 * np.abs(b).max(), (backend, key)
 
 
 def _run(scene, **solver):
@@ -54,25 +54,46 @@ def _run(scene, **solver):
 
 
 def test_linear_tol_sets_the_accuracy_of_amg():
-    """[solver] linear_tol is AMG-CG's relative residual: left at its default
-    the run is that of linear_tol = 1e-10 (to 1e-9: two AMG runs of the same
-    scene differ by about 1e-11 here, the threaded set-up summing in another
-    order); at 1e-6 it moves by the tolerance amplified by the contact
-    problem (40 times here: more than 1e-7, the agreement with the direct
-    backends at the default, and less than 1e-3); a direct backend ignores
-    it, bit for bit."""
-    scene = scene_from_dict(SCENES[2])
+    """[solver] linear_tol is AMG-CG's relative residual where AMG solves the
+    step outright (no Γ_C): left at its default the run is that of
+    linear_tol = 1e-10 (to 1e-9: two AMG runs of the same scene differ by
+    about 1e-11 here, the threaded set-up summing in another order); at
+    1e-4 it moves, by less than the tolerance (measured: 4e-9; CG
+    overshoots its stopping test); a direct backend ignores it, bit for
+    bit."""
+    doc = {**SCENES[2], "boundary": {"dirichlet": ["left"]}}
+    doc.pop("contact")
+    scene = scene_from_dict(doc)
     default = _run(scene, linear="amg")
     explicit = _run(scene, linear="amg", linear_tol=1e-10)
-    loose = _run(scene, linear="amg", linear_tol=1e-6)
+    loose = _run(scene, linear="amg", linear_tol=1e-4)
     assert default.success and loose.success
     scale = np.abs(default.u).max()
     assert np.abs(explicit.u - default.u).max() <= 1e-9 * scale
     change = np.abs(loose.u - default.u).max() / scale
-    assert 1e-7 < change < 1e-3
+    assert 1e-10 < change < 1e-4
     direct = _run(scene, linear="superlu")
-    direct_loose = _run(scene, linear="superlu", linear_tol=1e-6)
+    direct_loose = _run(scene, linear="superlu", linear_tol=1e-4)
     assert np.array_equal(direct.u, direct_loose.u)
+
+
+def test_amg_with_contact_is_as_accurate_as_the_step_tolerance():
+    """With Γ_C, AMG's Newton systems are solved to the step's forcing and
+    tolerance, not to linear_tol: a loose linear_tol leaves the run within
+    1e-9 (measured: 8e-13), while a loose step tolerance moves the AMG run
+    as it moves the direct one (1e-6: by 6e-8 and 9e-8 measured; each more
+    than 1e-9 and less than the tolerance)."""
+    scene = scene_from_dict(SCENES[2])
+    default = _run(scene, linear="amg")
+    scale = np.abs(default.u).max()
+    loose_linear = _run(scene, linear="amg", linear_tol=1e-6)
+    assert loose_linear.success
+    assert np.abs(loose_linear.u - default.u).max() <= 1e-9 * scale
+    for backend in ("amg", "superlu"):
+        reference = default if backend == "amg" else _run(scene, linear=backend)
+        loose = _run(scene, linear=backend, tol=1e-6)
+        assert loose.success
+        assert 1e-9 < np.abs(loose.u - reference.u).max() / scale < 1e-6, backend
 
 
 @pytest.mark.parametrize("value", [0.0, 1e-16, 0.5, "tight"])

@@ -52,6 +52,12 @@ MEMORY_FRACTION = 0.5   # of physical memory, the default limit
 # factorisation in a process loads MKL (about 1 s here): at 1e4 dofs 0.74
 # against 1.66 s in 2D, 0.05 against 1.06 s at 1e3 in 3D (studies/bench/ladder.py)
 SMALL = {2: 30_000, 3: 5_000}
+# from this many contact unknowns on, a 3D step is faster with AMG on all
+# free dofs than with a direct backend's dense Schur complement (the full
+# model of studies/bench/ladder.py: 1.5 times faster at 2520 unknowns and
+# 2.8e4 dofs, 2.3 times at 6336 and 1.1e5; in 2D the dense route stays
+# ahead, 7 times at 1282 unknowns and 1e5 dofs)
+AMG_CONTACT_FROM = 2000
 
 
 def factor_bytes(n, nnz, dim, method):
@@ -75,8 +81,13 @@ def _gb(nbytes):
     return f"{nbytes / 1e9:.3g} GB"
 
 
-def choose(n, nnz, dim, memory_limit=None):
+def choose(n, nnz, dim, memory_limit=None, contact_unknowns=0):
     """The backend for ``method = "auto"`` and one sentence saying why.
+
+    AMG is taken when the factors would not fit in ``memory_limit``, and in
+    3D from :data:`AMG_CONTACT_FROM` contact unknowns on: a direct backend
+    leaves the step method a dense Schur complement on them, AMG the sparse
+    Newton systems of all free dofs (:mod:`adhesive_contact.scheme.full_system`).
 
     Parameters
     ----------
@@ -86,12 +97,20 @@ def choose(n, nnz, dim, memory_limit=None):
     memory_limit : float, optional
         Bytes the factors may take (default: :func:`default_memory_limit`).
 
+    contact_unknowns : int
+        The unknowns on Γ_C a step solves for (0 where the step method
+        needs a Schur complement whatever the backend, "optimizer").
+
     Returns
     -------
     (name, reason) : (str, str)
     """
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    if dim == 3 and contact_unknowns >= AMG_CONTACT_FROM:
+        return "amg", (f"the step solves for {contact_unknowns} contact unknowns in 3D "
+                       f"(at least {AMG_CONTACT_FROM}): AMG-preconditioned Newton on all free "
+                       f"dofs is faster there than a dense Schur complement on them.")
     limit = default_memory_limit() if memory_limit is None else float(memory_limit)
     if n < SMALL[dim]:   # decided before asking for MKL, whose loading is the cost
         direct, label, why = "superlu", "SuperLU", (

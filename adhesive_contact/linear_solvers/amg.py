@@ -10,8 +10,14 @@ dofs in 3D (unit square and cube clamped on one side).
 """
 
 import numpy as np
+import scipy.sparse as sp
 
 from .base import LinearSolver, LinearSolverError
+
+#: the smoother on every level, before and after the coarse correction
+#: (pyamg's default for smoothed aggregation, named so that an updated
+#: hierarchy, :meth:`AMGSolver.updated`, gets the same)
+SMOOTHER = ("block_gauss_seidel", {"sweep": "symmetric"})
 
 
 def rigid_body_modes(points, dofs=None):
@@ -93,8 +99,10 @@ class AMGSolver(LinearSolver):
         if not tol > 0:
             raise ValueError(f"tol must be positive, got {tol}")
         self.B, self.tol, self.maxiter = B, float(tol), int(maxiter)
-        self.options = {"max_coarse": 100, **options}
+        self.options = {"max_coarse": 100, "presmoother": SMOOTHER, "postsmoother": SMOOTHER,
+                        **options}
         self.ml = None
+        self._sums = self._prolongators = None   # for updated(), made on first use
         super().__init__(A)
 
     def _setup(self, A):
@@ -161,3 +169,91 @@ class AMGSolver(LinearSolver):
         if self.ml is None:
             return super().aslinearoperator()
         return self.ml.aspreconditioner(cycle="V")
+
+    def updated(self, delta):
+        """One V-cycle for A + Δ on the hierarchy of A: its aggregates and
+        prolongators P_l kept, the level matrices
+
+            A_l + Δ_l,   Δ_0 = Δ,   Δ_{l+1} = P_lᵀ Δ_l P_l
+
+        (the Galerkin products of A + Δ), the smoothers set up anew. For a Δ
+        on a few rows, as a contact term's Hessian is, this costs O(nnz Δ)
+        and the smoothers' set-up on the coarse levels: P_lᵀ Δ_l P_l takes
+        only the rows of P_l where Δ_l lies, and Δ_l is added to A_l in
+        place (its entries lie in A_l's pattern; each call undoes the
+        previous one's). For Δ = 0 it is :meth:`aslinearoperator`'s V-cycle.
+
+        Returns ``(matrix, preconditioner)``: A + Δ (CSR) and the V-cycle,
+        both valid until the next call."""
+        from pyamg.multilevel import MultilevelSolver
+        from pyamg.relaxation.smoothing import change_smoothers
+
+        if self._sums is None:   # set up on first use
+            self._sums = [_PatternSum(level.A) for level in self.ml.levels]
+            self._prolongators = [sp.csr_matrix(level.P) for level in self.ml.levels[:-1]]
+        delta = sp.csr_matrix(delta)
+        levels = []
+        for l, level in enumerate(self.ml.levels):
+            new = MultilevelSolver.Level()
+            new.A = self._sums[l](delta)
+            if l + 1 < len(self.ml.levels):
+                new.P, new.R = level.P, level.R
+                rows = np.unique(delta.tocoo().row)
+                P = self._prolongators[l][rows]
+                delta = sp.csr_matrix(P.T @ delta[rows][:, rows] @ P)
+            levels.append(new)
+        ml = MultilevelSolver(levels)
+        change_smoothers(ml, self.options["presmoother"], self.options["postsmoother"])
+        return sp.csr_matrix(levels[0].A), ml.aspreconditioner(cycle="V")
+
+
+class _PatternSum:
+    """M + Δ for a fixed sparse M (CSR or BSR), in O(nnz Δ): M's values are
+    copied once, and each call undoes the previous call's additions before
+    making its own (so the matrix it returns is valid until the next call).
+    Entries of Δ outside M's pattern (a coupling that is zero in M, such as
+    one a rotation into nodal frames cancelled) join the pattern, stored as
+    zeros of M, at one O(nnz M) cost the first time they come."""
+
+    def __init__(self, M):
+        M.sort_indices()   # in place: the same matrix
+        self.M = M
+        self.block = M.blocksize if M.format == "bsr" else (1, 1)
+        rows, cols = M.shape[0] // self.block[0], M.shape[1] // self.block[1]
+        self.columns = cols
+        row = np.repeat(np.arange(rows, dtype=np.int64), np.diff(M.indptr))
+        self.keys = row * cols + M.indices   # increasing: M's entries in order
+        self.values = M.data.copy()
+        self.changed = None
+
+    def _positions(self, delta):
+        R, C = self.block
+        key = (delta.row // R).astype(np.int64) * self.columns + delta.col // C
+        pos = np.minimum(np.searchsorted(self.keys, key), max(self.keys.size - 1, 0))
+        return pos, self.keys[pos] == key
+
+    def _widen(self, rows, cols):
+        """M's pattern with the entries (rows, cols) added as stored zeros."""
+        M = self.M.tocoo()
+        wide = sp.coo_matrix((np.r_[M.data, np.zeros(rows.size)],
+                              (np.r_[M.row, rows], np.r_[M.col, cols])),
+                             shape=M.shape).tocsr()   # sums duplicates, keeps the zeros
+        self.__init__(wide.tobsr(blocksize=self.block) if self.M.format == "bsr" else wide)
+
+    def __call__(self, delta):
+        delta = delta.tocoo()
+        delta.sum_duplicates()
+        pos, inside = self._positions(delta)
+        if not inside.all():
+            self._widen(delta.row[~inside], delta.col[~inside])
+            pos, inside = self._positions(delta)
+        M = self.M
+        if self.changed is not None:
+            self.values[self.changed] = M.data[self.changed]
+        R, C = self.block
+        self.changed = (pos,) if M.format != "bsr" else (pos, delta.row % R, delta.col % C)
+        self.values[self.changed] += delta.data
+        if M.format == "bsr":
+            return sp.bsr_matrix((self.values, M.indices, M.indptr), shape=M.shape,
+                                 blocksize=self.block)
+        return sp.csr_matrix((self.values, M.indices, M.indptr), shape=M.shape)

@@ -130,9 +130,11 @@ class DenseSchur:
     def diagonal(self):
         return np.diag(self.matrix)
 
-    def newton_solve(self, H_phi, rhs, free):
+    def newton_solve(self, H_phi, rhs, free, accuracy=None):
         """Solve (S + H_φ)_FF d = rhs on the free coordinates F (a boolean
-        mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`.
+        mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`, to
+        round-off (an ``accuracy`` an iterative solve may stop at is not
+        needed).
         Only the entries of H_φ are added to the copy of S_FF; from
         MIXED_FROM free coordinates on, that copy is taken in single
         precision and the products of the refinement use S itself."""
@@ -188,9 +190,11 @@ class ImplicitSchur:
     def diagonal(self):
         return np.diag(self.approximation)
 
-    def newton_solve(self, H_phi, rhs, free):
+    def newton_solve(self, H_phi, rhs, free, accuracy=None):
         """Solve (S + H_φ)_FF d = rhs by CG with S applied, preconditioned by
-        (approximation + H_φ)_FF: ``(d, converged)``."""
+        (approximation + H_φ)_FF: ``(d, converged)``, to the relative
+        residual ``tol`` (each product is a solve pair: ``accuracy`` is not
+        used)."""
         idx = np.flatnonzero(free)
         H_FF = sp.csr_matrix(H_phi)[idx][:, idx]
         precondition = dense_solver(self.approximation[np.ix_(idx, idx)] + H_FF.toarray())

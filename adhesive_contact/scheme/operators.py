@@ -31,6 +31,7 @@ import numpy as np
 
 from ..linear_solvers import choose, make_linear_solver
 from .condensed import CondensedOperator, PartialCondensation
+from .full_system import FullSystemOperator
 
 #: the largest contraction bound for which t = 0 iterates on a_n's
 #: factorisation: ρ = 0.3 takes about 25 solve pairs, what a factorisation
@@ -56,9 +57,17 @@ class StepOperators:
 
     @property
     def linear(self):
-        """The linear backend of the run and why: {"method", "reason"}."""
+        """The linear backend of the run and why: {"method", "reason"}, and
+        with the step method on all free dofs (:mod:`.full_system`) the CG
+        iterations of its Newton systems so far, "cg_iterations"."""
         solver = self.step.solver
-        return {"method": solver.name, "reason": solver.reason}
+        record = {"method": solver.name, "reason": solver.reason}
+        if self.within is not None:
+            operators = {id(self.initial): self.initial, id(self.step): self.step}
+            record["newton_systems"] = ("on all free dofs, by CG preconditioned with the "
+                                        "hierarchy updated by the contact terms")
+            record["cg_iterations"] = sum(op.S.iterations for op in operators.values())
+        return record
 
     @classmethod
     def build(cls, problem, memory):
@@ -71,7 +80,8 @@ class StepOperators:
         method, reason = problem.scene.solver.linear, "method {!r} was asked for."
         if method == "auto":   # nnz of the free block, pro rata of the free dofs
             nnz = int(assembly.K_mu.nnz * free.size / max(assembly.ndofs, 1))
-            method, reason = choose(free.size, nnz, problem.dim)
+            method, reason = choose(free.size, nnz, problem.dim,
+                                    contact_unknowns=_newton_unknowns(problem))
         else:
             reason = reason.format(method)
 
@@ -98,8 +108,17 @@ class StepOperators:
             support[(lam, mu)] = (rows[:, free].T.tocsr(), rows)
             return A
 
+        # with AMG the step method iterates on all free dofs (a Schur complement
+        # would cost one CG solve per contact unknown); "optimizer" is left its
+        # Schur complement, L-BFGS-B having no preconditioner for a_n
+        unreduced = (method == "amg" and contact.size > 0
+                     and problem.scene.solver.method != "optimizer")
+
         def condensed(lam, mu, approximation=None):
             A = coupled(lam, mu)[free][:, free]
+            if unreduced:
+                return FullSystemOperator(A, contact, factorise=factorise,
+                                          solver=approximation)
             if method == "pardiso" and contact.size:   # S and the solve halves in one
                 operator = PartialCondensation(A, contact)
                 operator.solver.reason = reason
@@ -115,7 +134,9 @@ class StepOperators:
         initial, shift, rho = step, None, 0.0
         if (dlam, dmu) != (0.0, 0.0):
             rho = contraction(elastic, (dlam, dmu), problem.dim)
-            if rho <= PROXIMAL_UP_TO:   # t = 0 by the proximal iteration on a_n's factors
+            if unreduced:   # A at t = 0, preconditioned by a_n's hierarchy
+                initial = condensed(*elastic, approximation=step.solver)
+            elif rho <= PROXIMAL_UP_TO:   # t = 0 by the proximal iteration on a_n's factors
                 coupled(*elastic)
                 shift = frames(dlam, dmu)[free][:, free]
             else:   # with PARDISO the t = 0 operator forms S as cheaply as it applies it
@@ -127,6 +148,15 @@ class StepOperators:
                    tensors=(elastic, stepped), support=(support[elastic], support[stepped]),
                    factor_seconds=time.perf_counter() - t0, schur_seconds=schur,
                    shift=shift, contraction=rho)
+
+    @property
+    def within(self):
+        """(positions, size) of the contact unknowns within the step
+        unknowns when those are all free dofs (:mod:`.full_system`), else
+        None."""
+        if isinstance(self.step, FullSystemOperator):
+            return self.step.unknowns, self.free.size
+        return None
 
     def at(self, n):
         """The condensed step matrix of level n."""
@@ -167,3 +197,11 @@ def contraction(tensor, shift, dim):
     (lam, mu), (dlam, dmu) = tensor, shift
     kappa, dkappa = lam + 2.0 * mu / dim, dlam + 2.0 * dmu / dim
     return max(abs(dmu) / (mu + dmu), abs(dkappa) / (kappa + dkappa))
+
+
+def _newton_unknowns(problem):
+    """The contact unknowns of a step, for the backend choice: 0 for the
+    "optimizer" step method, which needs the Schur complement whatever the
+    backend."""
+    return 0 if problem.scene.solver.method == "optimizer" else int(problem.contact_positions.size)
+

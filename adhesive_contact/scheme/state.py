@@ -24,7 +24,7 @@ class State:
     n: int
     t: float
     beta: np.ndarray     # (nf,) β_n per contact facet
-    z: np.ndarray        # the step's contact unknowns (nodal frames)
+    z: np.ndarray        # the step's unknowns: the contact unknowns (nodal frames), or all free dofs
     u: np.ndarray        # (ndofs,) u_n, Cartesian
     frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes
     memory: object       # the run's memory history (adhesive_contact.memory)
@@ -56,18 +56,24 @@ NEWTON = ("newton", "newton-plain")   # the methods that converge quadratically
 class ContactStep:
     """The contact terms Φ of a run's steps and the kinks of its friction
     (:mod:`adhesive_contact.contact_energy`), solved by the scene's step
-    method (:mod:`adhesive_contact.step_methods`)."""
+    method (:mod:`adhesive_contact.step_methods`).
 
-    def __init__(self, problem):
+    ``within = (positions, size)`` when the step unknowns are the free dofs
+    (:mod:`.full_system`), the contact unknowns at ``positions`` among
+    them; by default they are the contact unknowns alone."""
+
+    def __init__(self, problem, within=None):
         boundary, nc, d = problem.boundary, problem.boundary.nodes.size, problem.dim
         self.problem = problem
         self.energy = ContactEnergy(boundary, problem.columns, problem.normal_law,
-                                    problem.friction, problem.beta0)
+                                    problem.friction, problem.beta0, within)
+        self.unknowns = self.energy.unknowns
+        self.size = self.energy.nz
         self.kink = None
         if problem.friction is not None:
             # every friction law gets its slip directions held (κ_a = 0 without a
             # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ
-            tangential = np.arange(problem.columns.size).reshape(nc, d)[:, 1:]
+            tangential = self.unknowns[np.arange(problem.columns.size).reshape(nc, d)[:, 1:]]
             self.kink = Kink(tangential, np.zeros(nc))
 
     def minimise(self, S, c, beta, n, z0, tighter=1.0):
@@ -82,8 +88,9 @@ class ContactStep:
         options = self.options(S)
         if solver.method in NEWTON:
             options = replace(options, tol=max(options.tol * tighter, 1e-14))
-        return minimise(solver.method, S, c, self.energy, problem.upper_bound(n), z0,
-                        options, self.kink)
+        upper = np.full(self.size, np.inf)
+        upper[self.unknowns] = problem.upper_bound(n)
+        return minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
 
     def options(self, S):
         """The StepOptions of a step with matrix S: the scene's tolerances and,
@@ -98,12 +105,15 @@ class ContactStep:
                            solver.smoothing * diameter)
 
 
-def initial_state(problem, memory):
-    """Level "−1": β_0^h = P_B β_0, zero displacement, an empty history."""
+def initial_state(problem, memory, unknowns=None):
+    """Level "−1": β_0^h = P_B β_0, zero displacement, an empty history;
+    ``unknowns`` the size of the step unknowns (default: the contact
+    unknowns)."""
     nc = 0 if problem.boundary is None else problem.boundary.nodes.size
     memory.begin(problem.scene.k, problem.ndofs)
+    size = problem.columns.size if unknowns is None else unknowns
     return State(n=-1, t=-problem.scene.k, beta=problem.beta0.copy(),
-                 z=np.zeros(problem.columns.size), u=np.zeros(problem.ndofs),
+                 z=np.zeros(size), u=np.zeros(problem.ndofs),
                  frame_u=np.zeros(nc * problem.dim), memory=memory)
 
 
@@ -178,8 +188,8 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
         return None, None, None, z0, result
     if contact is not None:
         # the force of Γ_C on the body: its reaction in the frame equations
-        force.reshape(-1)[problem.columns] = step.S @ z - c
-        on_wall = result.on_wall[problem.normal_columns]
+        force.reshape(-1)[problem.columns] = (step.S @ z - c)[contact.unknowns]
+        on_wall = result.on_wall[contact.unknowns][problem.normal_columns]
         if contact.kink is not None and problem.friction.has_kink:
             stuck = result.stuck
     u_frame = np.zeros(problem.ndofs)

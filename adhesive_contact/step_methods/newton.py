@@ -75,8 +75,11 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     ----------
     S : the condensed step matrix, a
         :class:`~adhesive_contact.scheme.condensed.DenseSchur` or
-        :class:`~adhesive_contact.scheme.condensed.ImplicitSchur`
-        (``S @ z``, ``diagonal()``, ``newton_solve``)
+        :class:`~adhesive_contact.scheme.condensed.ImplicitSchur`, or the
+        step matrix on all free dofs,
+        :class:`~adhesive_contact.scheme.full_system.FullSystemMatrix`
+        (``S @ z``, ``diagonal()``, ``newton_solve``; the contact unknowns
+        are then ``energy.unknowns`` among z)
     c : (nz,)
     energy : ContactEnergy
     upper : (nz,) bounds, +inf where there is none
@@ -102,7 +105,11 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     z = np.minimum(z0, upper)
     E = total(z)
     diag_S = np.maximum(S.diagonal(), 1e-300) if nz else np.zeros(0)
+    # the contact unknowns among z (all of z, but for the full system of
+    # adhesive_contact.scheme.full_system, whose other entries are interior dofs)
+    contact = energy.unknowns
     inner_failures = 0
+    forcing, last_residual = None, None
     for it in range(max_iter + 1):
         st = stationarity(S, c, energy, upper, z, kink)
         g, xi, s, at_zero, unit = st.g, st.xi, st.s, st.at_zero, st.unit
@@ -113,8 +120,9 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             break
 
         # identify the sets with a projected-gradient step length ε
-        width = np.abs(z - np.minimum(z - pg / np.where(diag_S > 0, diag_S, 1.0),
-                                      upper)).max(initial=0.0)
+        zc = z[contact]
+        width = np.abs(zc - np.minimum(zc - pg[contact] / diag_S[contact],
+                                       upper[contact])).max(initial=0.0)
         binding = bounded & (z >= upper - width) & (g < 0)
         stuck = (s <= width) & (hn <= kappa)
         fixed = binding.copy()
@@ -122,15 +130,18 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         if tan.size:
             fixed[tan[stuck]] = True
             d[tan[stuck]] = -xi[stuck]
-        zmax = np.abs(z).max(initial=0.0)
+        zmax = np.abs(zc).max(initial=0.0)
         Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)   # sparse, nodal blocks
         d[binding] = upper[binding] - z[binding]   # onto the wall
         free = ~fixed
         if free.any():
             moved = np.where(fixed, d, 0.0)
             rhs = -pg[free] - ((S @ moved)[free] + (Hphi @ moved)[free])
-            d[free], converged = S.newton_solve(Hphi, rhs, free)
+            forcing = eisenstat_walker(residual, last_residual, forcing)
+            d[free], converged = S.newton_solve(Hphi, rhs, free,
+                                                accuracy=(forcing, 0.5 * tol * scale))
             inner_failures += not converged
+        last_residual = residual
 
         # slipping directions held for this step
         ref = unit.copy()
@@ -194,3 +205,20 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
                       residual=residual / scale, tolerance=tol, energy=E,
                       inner_failures=inner_failures, multiplier=np.where(wall, -g, 0.0),
                       on_wall=wall, stuck=at_zero)
+
+
+def eisenstat_walker(residual, last, previous, gamma=0.9, largest=0.5):
+    """The relative residual an iterative solve of a Newton system may stop
+    at (Eisenstat and Walker's second choice): η_k = γ (r_k/r_{k−1})², not
+    below γ η_{k−1}² while that is above 0.1, at most ``largest``; the
+    first is ``largest``. While the sets move and the residual falls slowly,
+    a rough direction is as good as an exact one; once Newton converges,
+    η_k falls with the residual and the convergence stays superlinear."""
+    if last is None or previous is None:
+        return largest
+    eta = gamma * (residual / last) ** 2
+    floor = gamma * previous ** 2
+    if floor > 0.1:
+        eta = max(eta, floor)
+    return min(eta, largest)
+

@@ -12,10 +12,12 @@ is its own) and records:
   complement), ``stepping`` and ``total`` seconds, ``per_step``;
 - ``solve_pair``: the linear work of one step alone (condensing the load
   and expanding the interior: a forward and a backward solve with PARDISO's
-  partial factorisation, two solves with A_II otherwise), and
-  ``pairs_per_step`` = per_step / solve_pair: what a step costs in units of
-  its unavoidable linear work;
-- ``newton_per_step``; ``peak_mib``: the process's peak resident memory;
+  partial factorisation, two solves with A_II otherwise; with AMG, whose
+  step iterates on all free dofs, one AMG-CG solve of the step matrix),
+  and ``pairs_per_step`` = per_step / solve_pair: what a step costs in
+  units of its unavoidable linear work;
+- ``newton_per_step``; ``cg_per_step``: with AMG, the CG iterations of
+  the Newton systems a step; ``peak_mib``: the process's peak resident memory;
 - ``estimate_seconds``, ``estimate_mib``: what
   :func:`adhesive_contact.resources.estimate` predicted from the scene.
 
@@ -49,20 +51,25 @@ HERE = Path(__file__).resolve().parent
 STEPS = 20
 
 # size parameter m -> cells; dofs ≈ 2 (8m+1)(m+1) in 2D, 3 (4m+1)(m+1)(2m+1) in 3D.
-# The 3D full model at 1.1e5 dofs has 6336 contact unknowns: each Newton
-# iteration is a dense Cholesky of up to that size (a second or more), some
-# 260 of them in 20 steps
+# The 3D full model at 1.1e5 dofs has 6336 contact unknowns, at 9.9e5 dofs
+# 28152: "auto" takes AMG on all free dofs for it from 2000 on (a direct
+# backend's dense Cholesky of that size per Newton iteration, some 260 of
+# them in 20 steps, is what --backends pardiso shows)
 LADDER = {(2, "frictionless"): [8, 25, 80, 250], (2, "full"): [8, 25, 80, 250],
           (2, "elastic"): [8, 25, 80, 250],
-          (3, "frictionless"): [3, 7, 16], (3, "full"): [3, 7, 16], (3, "elastic"): [3, 7, 16]}
+          (3, "frictionless"): [3, 7, 16, 34], (3, "full"): [3, 7, 16, 34],
+          (3, "elastic"): [3, 7, 16, 34]}
 # SuperLU in 3D: its minimum degree fill grows like n^(5/3) (39 s to factorise
 # 4e4 dofs, studies/bench/linear_backends.py); a case takes up to three such
 # factorisations, so 1e5 dofs would take a quarter of an hour: skipped; in
 # 2D at 1e6 dofs its factors take 5 GB
 SKIP = {("superlu", 3): 2e4, ("superlu", 2): 3e5,
-        # AMG forms S by one CG solve per contact unknown (docs/scheme.md): it
-        # is the backend for meshes whose factors do not fit, shown small here
-        ("amg", 2): 3e4, ("amg", 3): 1.2e4}
+        # PARDISO's dense Schur route at 28152 contact unknowns: S alone 6.3 GB
+        # and a Cholesky of it per Newton iteration (minutes each)
+        ("pardiso", 3): 2e5,
+        # AMG in 2D: its Newton on all free dofs is 7 times slower than the
+        # dense Schur route at 1e5 dofs (1282 contact unknowns), shown small
+        ("amg", 2): 3e4}
 
 GLUE = {
     "normal": {"law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01},
@@ -115,12 +122,16 @@ def run_case(doc):
     timings = solution.timings
     # the linear work of one step, with the run's backend
     memory = problem.start_memory()
-    step = StepOperators.build(problem, memory).step
+    operators = StepOperators.build(problem, memory)
+    step = operators.step
     b = np.random.default_rng(0).standard_normal(problem.free.size)
     pairs = []
     for _ in range(3):
         t = time.perf_counter()
-        step.expand(step.reduce(b)[: step.contact.size] * 0.0, b)
+        if operators.within is not None:   # AMG on all free dofs: one AMG-CG solve
+            step.solver.solve(b)
+        else:
+            step.expand(step.reduce(b)[: step.contact.size] * 0.0, b)
         pairs.append(time.perf_counter() - t)
     per_step = timings["stepping"] / solution.t.size
     return {
@@ -134,6 +145,8 @@ def run_case(doc):
         "solve_pair": float(np.median(pairs)),
         "pairs_per_step": per_step / float(np.median(pairs)),
         "newton_per_step": float(solution.iterations[1:].mean()) if solution.t.size > 1 else 0.0,
+        # AMG on all free dofs: the CG iterations of its Newton systems a step
+        "cg_per_step": solution.linear.get("cg_iterations", 0) / max(solution.t.size - 1, 1),
         "peak_mib": peak,
         # adhesive_contact.resources' estimate from the scene alone, which a
         # run must not exceed by much (it refuses runs beyond the machine)
