@@ -38,6 +38,7 @@ import shutil
 from dataclasses import asdict, dataclass
 
 from .linear_solvers import choose, factor_bytes
+from .scheme.operators import FULL_SYSTEM
 from .scene import SceneError, nodes_of
 
 #: stored entries per node of a P1 stiffness row block, per component pair
@@ -174,7 +175,7 @@ def estimate(scene, memory_limit=None):
     levels = scene.steps + 1
     backend = scene.solver.linear
     reason = f"method {backend!r} was asked for."
-    newton = 0 if scene.solver.method == "optimizer" else unknowns
+    newton = unknowns if scene.solver.method in FULL_SYSTEM else 0
     if backend == "auto":
         backend, reason = choose(dofs, nnz, d, memory_limit, contact_unknowns=newton)
     # with AMG and contact, Newton on all free dofs: no dense S (the hierarchy

@@ -142,3 +142,27 @@ def test_auto_runs_a_3d_glued_block_on_all_free_dofs():
     assert guess.backend == "amg"
     dense = estimate(scene_from_dict(scene_dict({**GLUED_BLOCK, "solver.linear": "superlu"})))
     assert guess.memory_bytes < dense.memory_bytes
+
+
+PRESSED = {"dim": 3, "mesh": {"domain": "box", "size": [4.0, 1.0, 2.0], "cells": [12, 4, 4]},
+           "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
+           "loads": {"body": ["0", "-40*t", "0"]}, "time": {"T": 1.0, "steps": 5},
+           "contact": {"gap": 0.002, "normal": {"law": "compliance", "c": 1e4}}}
+
+
+@pytest.mark.parametrize("method", ["penalty", "newton-plain"])
+def test_other_step_methods_take_the_schur_complement_with_amg(method):
+    """With AMG only "newton" iterates on all free dofs: "penalty" (whose
+    penalty is scaled by the diagonal of S) and "newton-plain" (whose full
+    steps, clipped at the wall, would leave the interior behind) get the
+    Schur complement, and give the run of SuperLU on a block pressed onto a
+    compliant layer and a wall to 1e-8 (their AMG solves reach linear_tol =
+    1e-10)."""
+    runs = {}
+    for backend in ("amg", "superlu"):
+        changes = {**PRESSED, "solver": {"method": method, "linear": backend}}
+        runs[backend] = solve(build_problem(scene_from_dict(scene_dict(changes))))
+        assert runs[backend].success, (backend, runs[backend].message)
+    assert "cg_iterations" not in runs["amg"].linear
+    scale = np.abs(runs["superlu"].u).max()
+    assert np.abs(runs["amg"].u - runs["superlu"].u).max() <= 1e-8 * scale

@@ -99,7 +99,7 @@ def choose(n, nnz, dim, memory_limit=None, contact_unknowns=0):
 
     contact_unknowns : int
         The unknowns on Γ_C a step solves for (0 where the step method
-        needs a Schur complement whatever the backend, "optimizer").
+        needs a Schur complement whatever the backend: all but "newton").
 
     Returns
     -------

@@ -33,6 +33,15 @@ from ..linear_solvers import choose, make_linear_solver
 from .condensed import CondensedOperator, PartialCondensation
 from .full_system import FullSystemOperator
 
+#: the step methods that iterate on all free dofs with AMG (scheme/full_system.py).
+#: The others get a Schur complement formed by one AMG-CG solve per contact
+#: unknown: "optimizer" since L-BFGS-B has no preconditioner for a_n;
+#: "newton-plain" since its full steps, clipped at the wall, leave the
+#: interior behind the contact unknowns (the line search of "newton" mends
+#: that; without it the iterates can cycle where the condensed ones do not);
+#: "penalty" since its penalty is scaled by the diagonal of S
+FULL_SYSTEM = ("newton",)
+
 #: the largest contraction bound for which t = 0 iterates on a_n's
 #: factorisation: ρ = 0.3 takes about 25 solve pairs, what a factorisation
 #: costs in 2D (measured: 33 at 1e5 dofs, 28 at 1e6; about 130 in 3D); a
@@ -109,10 +118,9 @@ class StepOperators:
             return A
 
         # with AMG the step method iterates on all free dofs (a Schur complement
-        # would cost one CG solve per contact unknown); "optimizer" is left its
-        # Schur complement, L-BFGS-B having no preconditioner for a_n
+        # would cost one CG solve per contact unknown), if it can (FULL_SYSTEM)
         unreduced = (method == "amg" and contact.size > 0
-                     and problem.scene.solver.method != "optimizer")
+                     and problem.scene.solver.method in FULL_SYSTEM)
 
         def condensed(lam, mu, approximation=None):
             A = coupled(lam, mu)[free][:, free]
@@ -200,8 +208,10 @@ def contraction(tensor, shift, dim):
 
 
 def _newton_unknowns(problem):
-    """The contact unknowns of a step, for the backend choice: 0 for the
-    "optimizer" step method, which needs the Schur complement whatever the
+    """The contact unknowns of a step, for the backend choice: 0 for the step
+    methods not in FULL_SYSTEM, which need the Schur complement whatever the
     backend."""
-    return 0 if problem.scene.solver.method == "optimizer" else int(problem.contact_positions.size)
+    if problem.scene.solver.method not in FULL_SYSTEM:
+        return 0
+    return int(problem.contact_positions.size)
 

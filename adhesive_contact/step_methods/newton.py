@@ -137,7 +137,9 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         if free.any():
             moved = np.where(fixed, d, 0.0)
             rhs = -pg[free] - ((S @ moved)[free] + (Hphi @ moved)[free])
-            forcing = eisenstat_walker(residual, last_residual, forcing)
+            # inexact directions need the line search: full steps get exact ones
+            forcing = (eisenstat_walker(residual, last_residual, forcing) if globalised
+                       else 1e-12)
             d[free], converged = S.newton_solve(Hphi, rhs, free,
                                                 accuracy=(forcing, 0.5 * tol * scale))
             inner_failures += not converged
