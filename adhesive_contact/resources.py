@@ -38,8 +38,8 @@ import shutil
 from dataclasses import asdict, dataclass
 
 from .linear_solvers import choose, factor_bytes
-from .scheme.operators import FULL_SYSTEM
 from .scene import SceneError, nodes_of
+from .scheme.operators import FULL_SYSTEM
 
 #: stored entries per node of a P1 stiffness row block, per component pair
 #: (neighbours + 1: 7 on the structured triangle meshes, 15 on the tetrahedra)
