@@ -52,12 +52,18 @@ MEMORY_FRACTION = 0.5   # of physical memory, the default limit
 # factorisation in a process loads MKL (about 1 s here): at 1e4 dofs 0.74
 # against 1.66 s in 2D, 0.05 against 1.06 s at 1e3 in 3D (studies/bench/ladder.py)
 SMALL = {2: 30_000, 3: 5_000}
-# from this many contact unknowns on, a 3D step is faster with AMG on all
-# free dofs than with a direct backend's dense Schur complement (the full
-# model of studies/bench/ladder.py: 1.5 times faster at 2520 unknowns and
-# 2.8e4 dofs, 2.3 times at 6336 and 1.1e5; in 2D the dense route stays
-# ahead, 7 times at 1282 unknowns and 1e5 dofs)
-AMG_CONTACT_FROM = 2000
+# The seconds of one Newton iteration of the step method "newton" on m
+# contact unknowns: with a direct backend a dense Cholesky of S + ∂²Φ and
+# the O(m²) work around it, DENSE_NEWTON[0] m³ + DENSE_NEWTON[1] m²; with AMG
+# on all n free dofs, AMG_NEWTON n (a few CG iterations, the hierarchy's
+# update). Fitted to the 3D full model of studies/bench/ladder.py: dense
+# 0.4 s at m = 6336, 0.09 s at 2520; AMG 0.2 s at 1.1e5 dofs, 0.055 s at
+# 2.8e4. So AMG is 1.5 times faster at 2520 unknowns and 2.8e4 dofs, 2.3
+# times at 6336 and 1.1e5, and the dense route ahead for a frictionless 3D
+# step (2112 unknowns at 1.1e5 dofs) and in 2D (7 times at 1282 unknowns and
+# 1e5 dofs, measured).
+DENSE_NEWTON = (1.6e-12, 1e-8)
+AMG_NEWTON = 2e-6
 
 
 def factor_bytes(n, nnz, dim, method):
@@ -84,10 +90,11 @@ def _gb(nbytes):
 def choose(n, nnz, dim, memory_limit=None, contact_unknowns=0):
     """The backend for ``method = "auto"`` and one sentence saying why.
 
-    AMG is taken when the factors would not fit in ``memory_limit``, and in
-    3D from :data:`AMG_CONTACT_FROM` contact unknowns on: a direct backend
-    leaves the step method a dense Schur complement on them, AMG the sparse
-    Newton systems of all free dofs (:mod:`adhesive_contact.scheme.full_system`).
+    AMG is taken when the factors would not fit in ``memory_limit``, and
+    where a Newton iteration costs less with it (:data:`DENSE_NEWTON`,
+    :data:`AMG_NEWTON`): a direct backend leaves the step method a dense
+    Schur complement on the contact unknowns, AMG the sparse Newton systems
+    of all free dofs (:mod:`adhesive_contact.scheme.full_system`).
 
     Parameters
     ----------
@@ -107,10 +114,12 @@ def choose(n, nnz, dim, memory_limit=None, contact_unknowns=0):
     """
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
-    if dim == 3 and contact_unknowns >= AMG_CONTACT_FROM:
-        return "amg", (f"the step solves for {contact_unknowns} contact unknowns in 3D "
-                       f"(at least {AMG_CONTACT_FROM}): AMG-preconditioned Newton on all free "
-                       f"dofs is faster there than a dense Schur complement on them.")
+    m = contact_unknowns
+    dense, sparse = DENSE_NEWTON[0] * m**3 + DENSE_NEWTON[1] * m**2, AMG_NEWTON * n
+    if m and sparse < dense:
+        return "amg", (f"the step solves for {m} contact unknowns among {n} dofs: a Newton "
+                       f"iteration on all free dofs with AMG (about {sparse:.2g} s) is faster "
+                       f"than a dense Schur complement on them (about {dense:.2g} s).")
     limit = default_memory_limit() if memory_limit is None else float(memory_limit)
     if n < SMALL[dim]:   # decided before asking for MKL, whose loading is the cost
         direct, label, why = "superlu", "SuperLU", (
