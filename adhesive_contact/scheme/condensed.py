@@ -106,19 +106,14 @@ def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
     return solve
 
 
-class DenseSchur:
-    """S formed: a dense symmetric (nC, nC) matrix."""
+class RememberedProduct:
+    """``M @ z`` by ``self.matrix``, the last product with a vector kept:
+    the step methods ask for M z of the iterate a line search has just
+    tried (an O(m) comparison against a product)."""
 
-    def __init__(self, S):
-        self.matrix = S
-        self.shape = S.shape
-        self._single = None   # S in single precision, made on first use
-        self._last = (None, None)   # (z, S z) of the last product
+    _last = (None, None)   # (z, M z) of the last product
 
     def __matmul__(self, z):
-        """S z; the last product is kept, since the step methods ask for S z
-        of the iterate a line search has just tried (an O(m) comparison
-        against an O(m²) product)."""
         last, product = self._last
         if last is not None and last.shape == np.shape(z) and np.array_equal(last, z):
             return product.copy()
@@ -126,6 +121,15 @@ class DenseSchur:
         if np.ndim(z) == 1:
             self._last = (np.array(z, copy=True), product.copy())
         return product
+
+
+class DenseSchur(RememberedProduct):
+    """S formed: a dense symmetric (nC, nC) matrix."""
+
+    def __init__(self, S):
+        self.matrix = S
+        self.shape = S.shape
+        self._single = None   # S in single precision, made on first use
 
     def diagonal(self):
         return np.diag(self.matrix)

@@ -36,6 +36,8 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from .condensed import RememberedProduct
+
 
 def truncated_cg(apply, precondition, rhs, rtol, atol, maxiter, restarts=3):
     """Preconditioned CG for K x = rhs from x = 0, until the true residual
@@ -73,7 +75,7 @@ def truncated_cg(apply, precondition, rhs, rtol, atol, maxiter, restarts=3):
     return x, bool(np.linalg.norm(r) <= bound), iterations
 
 
-class FullSystemMatrix:
+class FullSystemMatrix(RememberedProduct):
     """a_n on the free dofs as the step method's operator (``@``,
     ``diagonal()``, ``newton_solve``), with CG preconditioned by the AMG
     hierarchy of ``solver`` (that of a_n, also for the t = 0 matrix A: the
@@ -87,19 +89,12 @@ class FullSystemMatrix:
         self.maxiter = maxiter
         self.vcycle = solver.aslinearoperator()
         self._diagonal = self.A.diagonal()
-        self._last = (None, None)   # (z, A z) of the last product
         self.iterations = 0         # CG iterations of all Newton systems so far
 
-    def __matmul__(self, z):
-        """a_n z; the last product is kept, as by
-        :class:`~adhesive_contact.scheme.condensed.DenseSchur`."""
-        last, product = self._last
-        if last is not None and last.shape == np.shape(z) and np.array_equal(last, z):
-            return product.copy()
-        product = self.A @ z
-        if np.ndim(z) == 1:
-            self._last = (np.array(z, copy=True), product.copy())
-        return product
+    @property
+    def matrix(self):
+        """a_n, for the products z ↦ a_n z (the last one kept)."""
+        return self.A
 
     def diagonal(self):
         return self._diagonal
