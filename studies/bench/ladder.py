@@ -166,7 +166,10 @@ def growth(rows, key):
 
 def write(rows, exponents):
     with open(HERE / "ladder.csv.tmp", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        # every key of every row (rows kept from an older ladder.json may lack
+        # the newer columns: empty there)
+        fields = list(dict.fromkeys(key for row in rows for key in row))
+        writer = csv.DictWriter(f, fieldnames=fields, restval="")
         writer.writeheader()
         writer.writerows(rows)
     os.replace(HERE / "ladder.csv.tmp", HERE / "ladder.csv")
