@@ -180,8 +180,8 @@ class AMGSolver(LinearSolver):
         on a few rows, as a contact term's Hessian is, this costs O(nnz Δ)
         and the smoothers' set-up on the coarse levels: P_lᵀ Δ_l P_l takes
         only the rows of P_l where Δ_l lies, and Δ_l is added to A_l in
-        place (its entries lie in A_l's pattern; each call undoes the
-        previous one's). For Δ = 0 it is :meth:`aslinearoperator`'s V-cycle.
+        place (in A_l's pattern, widened once for entries outside it; each
+        call undoes the previous one's). For Δ = 0 it is :meth:`aslinearoperator`'s V-cycle.
 
         Returns ``(matrix, preconditioner)``: A + Δ (CSR) and the V-cycle,
         both valid until the next call."""
