@@ -26,8 +26,8 @@ make a_n + H_φ indefinite, and CG then stops at the first direction of
 negative curvature with its last iterate, a descent direction (Steihaug).
 
 A step then costs the Newton iterations' CG iterations, each a product with
-a_n and a V-cycle (measured: 3.2 CG iterations a Newton system on the 3D
-full model of studies/bench/ladder.py at 2.8e4 and 1.1e5 dofs), and no
+a_n and a V-cycle (measured: 3.4–3.8 CG iterations a Newton system on the 3D
+full model of studies/bench/ladder.py from 2.8e4 to 1e6 dofs), and no
 solve pair.
 """
 
