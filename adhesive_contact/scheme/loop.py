@@ -44,13 +44,13 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     t0 = time.perf_counter()
     memory = problem.start_memory()
     operators = StepOperators.build(problem, memory)
-    within = operators.within
-    contact = ContactStep(problem, within) if problem.boundary is not None else None
+    contact = (ContactStep(problem, operators.within) if problem.boundary is not None
+               else None)
     recorder = recorder or HistoryRecorder(problem)
     t_loop = time.perf_counter()
     with one_blas_thread():   # a step's algebra is small or latency-bound
         status, failure, state = march(problem, operators, contact, recorder,
-                                       initial_state(problem, memory, within and within[1]),
+                                       initial_state(problem, memory, contact and contact.size),
                                        progress)
     if failure is not None and raise_on_failure:
         raise failure

@@ -72,10 +72,9 @@ class StepOperators:
         solver = self.step.solver
         record = {"method": solver.name, "reason": solver.reason}
         if self.within is not None:
-            operators = {id(self.initial): self.initial, id(self.step): self.step}
             record["newton_systems"] = ("on all free dofs, by CG preconditioned with the "
                                         "hierarchy updated by the contact terms")
-            record["cg_iterations"] = sum(op.S.iterations for op in operators.values())
+            record["cg_iterations"] = sum(op.S.iterations for op in {self.initial, self.step})
         return record
 
     @classmethod
@@ -122,35 +121,37 @@ class StepOperators:
         unreduced = (method == "amg" and contact.size > 0
                      and problem.scene.solver.method in FULL_SYSTEM)
 
-        def condensed(lam, mu, approximation=None):
+        def step_operator(lam, mu, nearby=None):
+            """The operator of (λ, μ) on the free dofs; ``nearby`` is what the
+            step matrix lends it to precondition with (its Schur complement, or
+            with AMG its hierarchy), or None to set up its own."""
             A = coupled(lam, mu)[free][:, free]
             if unreduced:
-                return FullSystemOperator(A, contact, factorise=factorise,
-                                          solver=approximation)
+                return FullSystemOperator(A, contact, factorise=factorise, solver=nearby)
             if method == "pardiso" and contact.size:   # S and the solve halves in one
                 operator = PartialCondensation(A, contact)
                 operator.solver.reason = reason
                 return operator
             return CondensedOperator(A, contact, factorise=factorise,
-                                     approximation=approximation)
+                                     approximation=nearby)
 
         material = problem.scene.material
         elastic = (material.lam, material.mu)
         dlam, dmu = memory.instantaneous(problem.scene.k)
         stepped = (material.lam + dlam, material.mu + dmu)
-        step = condensed(*stepped)
+        step = step_operator(*stepped)
         initial, shift, rho = step, None, 0.0
         if (dlam, dmu) != (0.0, 0.0):
             rho = contraction(elastic, (dlam, dmu), problem.dim)
             if unreduced:   # A at t = 0, preconditioned by a_n's hierarchy
-                initial = condensed(*elastic, approximation=step.solver)
+                initial = step_operator(*elastic, nearby=step.solver)
             elif rho <= PROXIMAL_UP_TO:   # t = 0 by the proximal iteration on a_n's factors
                 coupled(*elastic)
                 shift = frames(dlam, dmu)[free][:, free]
             else:   # with PARDISO the t = 0 operator forms S as cheaply as it applies it
-                approximation = (None if isinstance(step, PartialCondensation)
+                nearby = (None if isinstance(step, PartialCondensation)
                                  else step.S.matrix)
-                initial = condensed(*elastic, approximation=approximation)
+                initial = step_operator(*elastic, nearby=nearby)
         schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
         return cls(rotation=R, free=free, initial=initial, step=step,
                    tensors=(elastic, stepped), support=(support[elastic], support[stepped]),
