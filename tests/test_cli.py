@@ -585,9 +585,13 @@ def test_glued_contact_xdmf_carries_the_contact_fields(glued):
     _, out, _, arrays = glued
     problem = build_problem(parse_scene(GLUED))
     sol = solve(problem)
-    nodes = problem.boundary.nodes
     reader = meshio.xdmf.TimeSeriesReader(out / "contact.xdmf")
-    reader.read_points_cells()
+    points, cells = reader.read_points_cells()
+    # its points are the facets' vertices alone, in increasing mesh index
+    vertices = np.unique(problem.boundary.facet_nodes)
+    np.testing.assert_array_equal(points[:, :2], problem.mesh.p.T[vertices])
+    np.testing.assert_array_equal(vertices[cells[0].data], problem.boundary.facet_nodes.T)
+    nodes = np.searchsorted(vertices, problem.boundary.nodes)
     codes = contact_state_codes(sol)
     traction = contact_traction(sol, "global")
     for n in range(reader.num_steps):
