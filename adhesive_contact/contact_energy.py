@@ -55,15 +55,9 @@ class ContactEnergy:
         self.friction = friction
         self.T = ([trace(t) for t in boundary.tangential_trace]
                   if friction is not None else [])
-        if self.T:
-            # all tangential traces stacked (m·nq, nz), and the positions of
-            # the point blocks (i, j) of the friction Hessian in (m·nq)²
-            nq, m = self.w.size, len(self.T)
-            self.T_all = sp.vstack(self.T).tocsr()
-            q = np.arange(nq)
-            self.block_rows = (np.arange(m)[:, None, None] * nq + q).repeat(m, axis=1)
-            self.block_cols = (np.arange(m)[None, :, None] * nq + q).repeat(m, axis=0)
         self.nz = size
+        self.hessian_map = HessianMap(self.N if normal_law.active else None, self.T,
+                                      self.w.size, size)
         self.set_bonding(beta)
 
     def set_bonding(self, beta):
@@ -92,11 +86,15 @@ class ContactEnergy:
         return g
 
     def hessian(self, z, s_floor=0.0):
-        """Sparse (nz, nz); ``s_floor`` bounds |ξ| from below in φ''."""
-        H = sp.csr_matrix((self.nz, self.nz))
+        """Sparse (nz, nz); ``s_floor`` bounds |ξ| from below in φ''.
+
+        H = Nᵀ diag(w p_ν') N + Σ_ij T_iᵀ diag(w b_ij) T_j, with b the
+        point blocks of the friction Hessian in the module doc, entered
+        through :class:`HessianMap` (one sparse product, no sparse algebra
+        per call)."""
+        normal = blocks = None
         if self.normal_law.active:
-            d = self.w * self.normal_law.derivative(self.beta, self.N @ z)
-            H = H + self.N.T @ sp.diags(d) @ self.N
+            normal = self.w * self.normal_law.derivative(self.beta, self.N @ z)
         if self.friction is not None:
             xi = self._xi(z)
             s = np.linalg.norm(xi, axis=-1)
@@ -104,20 +102,16 @@ class ContactEnergy:
             dd = self.friction.ddphi(self.beta, sf)
             m = len(self.T)
             if m == 1:
-                blocks = dd[:, None, None] * np.ones((1, 1, 1))
+                blocks = dd[:, None, None]
             else:
                 e = np.where(s[:, None] > 0, xi / np.where(s > 0, s, 1.0)[:, None], 0.0)
                 ee = e[:, :, None] * e[:, None, :]
-                tang = np.where(s > 0, self.friction.dphi(self.beta, sf) / sf, 0.0)
+                tang = np.where(s > 0, self.friction.dphi(self.beta, sf)
+                                / np.where(sf > 0, sf, 1.0), 0.0)
                 blocks = (dd[:, None, None] * np.where(s[:, None, None] > 0, ee, np.eye(m))
                           + tang[:, None, None] * (np.eye(m) - ee))
-            # Σ_ij T_iᵀ diag(w b_ij) T_j as one product T_allᵀ B T_all
-            n = m * self.w.size
-            B = sp.csr_matrix(((self.w[:, None, None] * blocks).transpose(1, 2, 0).ravel(),
-                               (self.block_rows.ravel(), self.block_cols.ravel())),
-                              shape=(n, n))
-            H = H + self.T_all.T @ B @ self.T_all
-        return H.tocsr()
+            blocks = self.w[:, None, None] * blocks
+        return self.hessian_map(normal, blocks)
 
     def node_kink(self, nodes_of_points, n_nodes):
         """κ_a = Σ_{q at a} w_q φ'(β_q, 0+) per contact node (nodal rule)."""
@@ -126,3 +120,60 @@ class ContactEnergy:
         keep = nodes_of_points >= 0   # clamped vertices carry no unknown
         return np.bincount(nodes_of_points[keep],
                            (self.w * self.friction.kink(self.beta))[keep], minlength=n_nodes)
+
+
+def _row_pairs(A, B):
+    """For csr A, B with the same rows: every pair of a nonzero of A and a
+    nonzero of B in the same row q, as (q, column in A, column in B,
+    A value · B value)."""
+    A, B = A.tocsr(), B.tocsr()
+    na, nb = np.diff(A.indptr), np.diff(B.indptr)
+    row = np.repeat(np.arange(A.shape[0]), na)             # the row of each nonzero of A
+    a = np.repeat(np.arange(A.nnz), nb[row])                # nonzero of A, once per partner
+    first = np.repeat(np.cumsum(nb[row]) - nb[row], nb[row])
+    b = B.indptr[row[a]] + np.arange(a.size) - first        # its partners in B
+    return row[a], A.indices[a], B.indices[b], A.data[a] * B.data[b]
+
+
+class HessianMap:
+    """The Hessian of Φ as a linear map of its point coefficients:
+
+        H = Nᵀ diag(n) N + Σ_ij T_iᵀ diag(b_ij) T_j,
+
+    n (nq,) and b (nq, m, m) per quadrature point q. Entry (k, l) of H is
+    Σ_q n_q N_qk N_ql + Σ_qij b_qij (T_i)_qk (T_j)_ql: linear in (n, b), so
+    H's data is one sparse product E [n; b] with E (nnz H, nq (1 + m²))
+    built once, on the pattern of all entries any coefficients can fill."""
+
+    def __init__(self, N, T, nq, size):
+        rows, cols, coefs, values = [], [], [], []
+        m = len(T)
+        if N is not None:
+            q, k, l, v = _row_pairs(N, N)
+            rows.append(k), cols.append(l), coefs.append(q), values.append(v)
+        for i, Ti in enumerate(T):
+            for j, Tj in enumerate(T):
+                q, k, l, v = _row_pairs(Ti, Tj)
+                # b_qij sits after the nq normal coefficients, at q·m² + i·m + j
+                rows.append(k), cols.append(l), coefs.append(nq + (q * m + i) * m + j)
+                values.append(v)
+        cat = (lambda x: np.concatenate(x) if x else np.zeros(0, dtype=np.int64))
+        rows, cols, coefs, values = cat(rows), cat(cols), cat(coefs), cat(values)
+        keys, entry = np.unique(rows * size + cols, return_inverse=True)   # row-major order
+        self.indices = (keys % size).astype(np.int32)
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // size,
+                                                                 minlength=size))]).astype(np.int32)
+        self.expansion = sp.csr_matrix((values, (entry, coefs)),
+                                       shape=(keys.size, nq * (1 + m * m)))
+        self.nq, self.m, self.size = nq, m, size
+
+    def __call__(self, normal=None, blocks=None):
+        """H (csr) for n = ``normal`` (nq,) and b = ``blocks`` (nq, m, m);
+        None for a term the energy does not have."""
+        coef = np.zeros(self.expansion.shape[1])
+        if normal is not None:
+            coef[:self.nq] = normal
+        if blocks is not None:
+            coef[self.nq:] = blocks.ravel()
+        return sp.csr_matrix((self.expansion @ coef, self.indices.copy(), self.indptr.copy()),
+                             shape=(self.size, self.size))

@@ -123,6 +123,16 @@ class RememberedProduct:
         return product
 
 
+def restricted(H, free):
+    """H_FF (coo) of a sparse H on the coordinates where ``free`` is True."""
+    H = sp.coo_matrix(H)
+    keep = free[H.row] & free[H.col]
+    position = np.cumsum(free) - 1
+    n = int(position[-1]) + 1 if free.size else 0
+    return sp.coo_matrix((H.data[keep], (position[H.row[keep]], position[H.col[keep]])),
+                         shape=(n, n))
+
+
 class DenseSchur(RememberedProduct):
     """S formed: a dense symmetric (nC, nC) matrix."""
 
@@ -144,10 +154,10 @@ class DenseSchur(RememberedProduct):
         precision and the products of the refinement use S itself."""
         idx = np.flatnonzero(free)
         everything = idx.size == free.size
-        block = sp.coo_matrix(sp.csr_matrix(H_phi)[idx][:, idx])
+        block = restricted(H_phi, free)
 
         def exact():
-            H = self.matrix.copy() if everything else self.matrix[np.ix_(idx, idx)]
+            H = self.matrix.copy() if everything else self.matrix.take(idx, 0).take(idx, 1)
             H[block.row, block.col] += block.data
             return H
 
@@ -200,8 +210,9 @@ class ImplicitSchur:
         residual ``tol`` (each product is a solve pair: ``accuracy`` is not
         used)."""
         idx = np.flatnonzero(free)
-        H_FF = sp.csr_matrix(H_phi)[idx][:, idx]
-        precondition = dense_solver(self.approximation[np.ix_(idx, idx)] + H_FF.toarray())
+        H_FF = restricted(H_phi, free).tocsr()
+        precondition = dense_solver(self.approximation.take(idx, 0).take(idx, 1)
+                                    + H_FF.toarray())
         full = np.zeros(self.shape[0])
 
         def apply(v):
