@@ -144,11 +144,14 @@ def echo_warnings(problem):
 def running_study(out, executor, saved):
     """Run a study's block: a lost scheduler or an unwritable ``out`` is a
     CliError (exit 1) saying the finished ``saved`` ("runs", "levels") are
-    kept; the executor is closed whatever happens."""
+    kept, Ctrl-C one with exit 130; the executor is closed whatever happens."""
     from adhesive_contact.studies.executors import ClusterError
 
     try:
         yield
+    except KeyboardInterrupt:
+        raise CliError(f"interrupted; the finished {saved} are saved in {out}/ and the same "
+                       "command resumes from them", 130) from None
     except ClusterError as err:
         raise CliError(f"--scheduler {err.address}: {err.message}; the finished {saved} are "
                        "saved, the same command resumes", 1) from None

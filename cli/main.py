@@ -2,7 +2,8 @@
 
 Exit codes: 0 success; 2 a bad scene or bad arguments (nothing written);
 1 a run that failed (a step that did not converge or gave an invalid
-state) or outputs that could not be written; 130 a run stopped by Ctrl-C.
+state) or outputs that could not be written; 130 a run or a study stopped
+by Ctrl-C (a study keeps its finished runs and resumes from them).
 Every error is one line ``error: ...`` on stderr. The scene is parsed and
 the problem built before any file is created; a run that fails or is
 interrupted writes the levels it finished, marked partial in summary.json
@@ -64,9 +65,9 @@ class OneLineGroup(click.Group):
                 message += f" (see '{ctx.command_path} --help')"
             click.echo(f"error: {message}", err=True)
             sys.exit(err.exit_code)
-        except click.Abort:
-            click.echo("error: aborted", err=True)
-            sys.exit(1)
+        except click.Abort:   # Ctrl-C outside a time loop or a study's runs
+            click.echo("error: interrupted", err=True)
+            sys.exit(130)
         except MemoryError:
             click.echo("error: out of memory (the run needed more than the machine had; "
                        "the size check was skipped with --force or underestimated it)",

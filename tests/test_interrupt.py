@@ -1,8 +1,10 @@
 """Runs that fail or are interrupted: Ctrl-C stops ``adhcontact solve`` at
 the end of a step, keeps the levels done (marked partial) and exits 130;
-a failure at t = 0 writes nothing."""
+it stops a sweep, whose finished runs are kept and resumed from, with
+exit 130 and one line; a failure at t = 0 writes nothing."""
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -10,6 +12,7 @@ import threading
 import time
 
 import numpy as np
+import pytest
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 from conftest import law, scene_dict, to_toml
@@ -69,3 +72,53 @@ def test_failure_at_the_first_level_writes_nothing(tmp_path):
     assert "step 0 (t = 0) did not converge: no convergence in 1 iterations" in result.stderr
     assert "Nothing was written." in result.stderr
     assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
+
+
+def interrupt_when(args, cwd, ready, timeout=120):
+    """Run ``adhcontact args`` in its own process group, send the group
+    SIGINT (what Ctrl-C in a terminal does) once ``ready()`` holds, and
+    return (exit code, stderr, whether a process of the group outlived it
+    by 5 s)."""
+    code = "from adhesive_contact_cli.main import main; main()"
+    proc = subprocess.Popen([sys.executable, "-c", code, *args], cwd=cwd,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    deadline = time.monotonic() + timeout
+    while not ready():
+        assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read()
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)
+    code = proc.wait(60)
+    stderr = proc.stderr.read()
+    for _ in range(50):
+        try:
+            os.killpg(proc.pid, 0)   # raises once no process of the group is left
+        except ProcessLookupError:
+            return code, stderr, False
+        time.sleep(0.1)
+    return code, stderr, True
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_ctrl_c_stops_a_sweep_which_resumes_from_the_runs_done(tmp_path, jobs):
+    # each run some 2000 steps of a few ms: seconds, so the first finishes
+    # well before the last and the interrupt lands among them
+    (tmp_path / "scene.toml").write_text(to_toml(scene_dict({"time.steps": 1500}, SCENE_DICT)))
+    runs = tmp_path / "out" / "runs"
+    values = "contact.normal.c=1000,2000,3000,4000,5000,6000"
+    args = ["sweep", "scene.toml", "--set", values, "--out", "out", "--jobs", str(jobs)]
+    code, stderr, left = interrupt_when(args, tmp_path,
+                                        lambda: runs.is_dir() and any(runs.glob("run_*.json")))
+    assert code == 130, stderr
+    assert not left   # no worker left computing
+    errors = [line for line in stderr.splitlines() if line.startswith("error: ")]
+    assert errors == ["error: interrupted; the finished runs are saved in out/ and the same "
+                      "command resumes from them"], stderr
+    assert "Traceback" not in stderr
+    done = len(list(runs.glob("run_*.json")))
+    assert 1 <= done < 6
+    result = subprocess.run([sys.executable, "-c",
+                             "from adhesive_contact_cli.main import main; main()", *args],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert f"{6 - done} computed now, {done} loaded" in result.stdout

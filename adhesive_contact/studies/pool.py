@@ -22,6 +22,7 @@ decides whether it stops the study or is reported and retried later.
 """
 
 import multiprocessing
+import signal
 import threading
 from concurrent.futures import CancelledError, ProcessPoolExecutor
 from concurrent.futures import as_completed as futures_completed
@@ -42,6 +43,14 @@ def _install(token, setup, args):
     with _LOCK:
         _CONTEXTS[token] = (setup, args)
         _STATES.pop(token, None)
+
+
+def _worker_start(token, setup, args):
+    """Initializer of a local worker process: Ctrl-C, which the terminal
+    sends to the whole process group, is the calling process's to handle
+    (it stops the study and ends the workers); then :func:`_install`."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _install(token, setup, args)
 
 
 def _state(token, context=None):
@@ -137,12 +146,32 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
             return _collect(futures, completed, on_record, on_lost, lost)
         finally:
             executor.uninstall(token)
-    with ProcessPoolExecutor(max_workers=min(jobs, len(keys)),
-                             mp_context=multiprocessing.get_context("spawn"),
-                             initializer=_install, initargs=(token, *context)) as pool:
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(keys)),
+                               mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_start, initargs=(token, *context))
+    try:
         futures = {pool.submit(run_task, token, compute, key): key for key in keys}
-        return _collect(futures, as_completed or futures_completed, on_record, on_lost,
-                        (BrokenProcessPool, CancelledError))
+        failure = _collect(futures, as_completed or futures_completed, on_record, on_lost,
+                           (BrokenProcessPool, CancelledError))
+    except BaseException:
+        # an interrupt (or a record that could not be saved): the runs in
+        # the workers are lost; end the workers now rather than after them
+        _end_workers(pool)
+        raise
+    pool.shutdown()
+    return failure
+
+
+def _end_workers(pool):
+    """Stop a local pool at once: the queued runs cancelled, the worker
+    processes terminated (concurrent.futures has no public call for it
+    before Python 3.14)."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join(5)
 
 
 def _collect(futures, as_completed, on_record, on_lost, lost):
