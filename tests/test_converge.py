@@ -38,7 +38,7 @@ EXACT_SCENE, CONTACT_SCENE = to_toml(EXACT), to_toml(CONTACT)
 REF_K = default_reference_refinement("k")[1]
 FIRM_LEVEL_KEYS = {"h", "k", "dofs", "err_u", "err_beta", "E", "seconds"}
 CSV_COLUMNS = ["level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
-               "seconds"]
+               "seconds", "rel_u", "rel_beta", "rel_E"]
 
 
 def run(*args):
@@ -155,6 +155,10 @@ def test_exact_study_writes_the_firm_outputs(exact_study):
     for row, level in zip(rows, levels):
         record = dict(zip(header, row))
         assert float(record["E"]) == level["E"] and int(record["dofs"]) == level["dofs"]
+        # the relative errors of rates.json, null there (no β error) empty here
+        assert (float(record["rel_u"]), float(record["rel_E"])) == (level["rel_u"],
+                                                                    level["rel_E"])
+        assert level["rel_beta"] is None and record["rel_beta"] == ""
     assert rows[0][header.index("rate_E")] == ""
 
     study = strict_json(out / "study.json")

@@ -58,7 +58,7 @@ FLOAT_KEYS = ("h", "k", "err_u", "err_beta", "E", "seconds")
 RELATIVE_KEYS = ("rel_u", "rel_beta", "rel_E")
 RECORD_KEYS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "seconds")
 CSV_COLUMNS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
-               "seconds")
+               "seconds", *RELATIVE_KEYS)
 #: docs/verification.md: a rate is fitted over at least 4 levels
 MEANINGFUL_LEVELS = 4
 #: the largest run a study may ask for (dofs); beyond it the set-up alone
@@ -168,7 +168,8 @@ def trust(document):
 
 def error_rows(document):
     """The rows of ``errors.csv`` (:data:`CSV_COLUMNS`), one per level: floats
-    as repr, None (a rate_E on the first level, a NaN) as an empty cell."""
+    as repr, None (a rate_E on the first level, a NaN, a relative error of
+    a zero solution or of a level saved without it) as an empty cell."""
     return [["" if row[key] is None else
              (repr(float(row[key])) if isinstance(row[key], float) else row[key])
              for key in CSV_COLUMNS] for row in document["levels"]]
