@@ -19,7 +19,10 @@ is its own) and records:
 - ``newton_per_step``; ``cg_per_step``: with AMG, the CG iterations of
   the Newton systems a step; ``peak_mib``: the process's peak resident memory;
 - ``estimate_seconds``, ``estimate_mib``: what
-  :func:`adhesive_contact.resources.estimate` predicted from the scene.
+  :func:`adhesive_contact.resources.estimate` predicted from the scene;
+- ``repeats``, ``spread``: with ``--repeat R`` a case (up to
+  ``--max-repeat-dofs``) runs R times, each in its own process, and its
+  fastest run is the row; ``spread`` is its slowest total over its fastest.
 
 It writes ``ladder.csv``, ``ladder.json`` (with the machine) and
 ``ladder.png`` beside this script, and prints the fitted growth exponents
@@ -27,6 +30,7 @@ of set-up and step time in the dofs and, per size, the full model's total
 time over its fastest elastic baseline's (any backend).
 
     python studies/bench/ladder.py [--max-dofs 1.1e6] [--backends auto,superlu,amg] [--dims 2,3]
+                                   [--repeat 3]
 
 (AMG and SuperLU stop below the largest sizes: see SKIP.)
 
@@ -235,6 +239,11 @@ def main():
     parser.add_argument("--dims", default="2,3",
                         help="the dimensions to run; the rows of the others are kept "
                              "from ladder.json")
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="runs of each case, the fastest kept (timings on a shared "
+                             "machine move by 20-45 %% from run to run)")
+    parser.add_argument("--max-repeat-dofs", type=float, default=2e5,
+                        help="cases above this size run once whatever --repeat says")
     parser.add_argument("--case", help=argparse.SUPPRESS)   # one case, in a child process
     parser.add_argument("--replot", action="store_true",
                         help="redraw ladder.png from ladder.json without running")
@@ -263,13 +272,11 @@ def main():
                 if dofs > SKIP.get((backend, dim), np.inf):
                     print(f"{dim}D {model} {backend}: {dofs} dofs skipped (see SKIP)")
                     continue
-                case = json.dumps(scene(dim, m, model, backend))
-                done = subprocess.run([sys.executable, __file__, "--case", case],
-                                      capture_output=True, text=True)
-                if done.returncode:
-                    print(f"{dim}D {model} {backend} m={m}: failed\n{done.stderr[-2000:]}")
+                row = run_repeated(scene(dim, m, model, backend),
+                                   args.repeat if dofs <= args.max_repeat_dofs else 1)
+                if isinstance(row, str):
+                    print(f"{dim}D {model} {backend} m={m}: failed\n{row}")
                     continue
-                row = json.loads(done.stdout.splitlines()[-1])
                 rows.append(row)
                 print(f"{dim}D {model:12s} {row['backend']:8s} {row['dofs']:8d} dofs, "
                       f"{row['contact_unknowns']:5d} on Γ_C: set-up {row['setup']:7.2f} s, "
@@ -290,6 +297,22 @@ def main():
             print(f"{row['dim']}D full / elastic, {row['backend']}, {row['dofs']} dofs: "
                   f"{row['over_elastic']:.2f} x")
     write(rows, exponents)
+
+
+def run_repeated(doc, repeat):
+    """The row of the fastest of ``repeat`` runs of a case, each in its own
+    process, with ``repeats`` and ``spread`` (slowest over fastest total);
+    the child's stderr tail when a run fails."""
+    found = []
+    for _ in range(repeat):
+        done = subprocess.run([sys.executable, __file__, "--case", json.dumps(doc)],
+                              capture_output=True, text=True)
+        if done.returncode:
+            return done.stderr[-2000:]
+        found.append(json.loads(done.stdout.splitlines()[-1]))
+    totals = [row["total"] for row in found]
+    return min(found, key=lambda row: row["total"]) | {
+        "repeats": repeat, "spread": max(totals) / min(totals)}
 
 
 def over_elastic(row, rows):
