@@ -63,69 +63,95 @@ def node_pattern(mesh):
 
     Returns ``(indptr, indices, slot)``: the CSR pattern (n_nodes rows,
     sorted columns) and, for each pair (e, i, j) in C order of (cell, local
-    vertex i, local vertex j), its position in ``indices``."""
+    vertex i, local vertex j), its position in ``indices``.
+
+    The pattern is that of EᵀE, E the (cells × nodes) incidence matrix (a
+    sparse product, linear in the cells); a pair's position is found by a
+    binary search of its key i·n + j among the pattern's keys, which are
+    sorted (row-major). Both avoid sorting the (d+1)² keys of every cell,
+    which took 2.4 s of 2.7 for the 2e6 triangles of a 1e6-dof strip."""
     t = mesh.t
     nv, ne = t.shape
     n = mesh.p.shape[1]
     cells = t.T.astype(np.int64)
-    key = (cells[:, :, None] * n + cells[:, None, :]).ravel()
-    unique, slot = np.unique(key, return_inverse=True)   # sorted: row-major order
-    indptr = np.searchsorted(unique, np.arange(n + 1, dtype=np.int64) * n)
-    return indptr, (unique % n).astype(np.int32 if n < 2**31 else np.int64), slot.ravel()
+    incidence = sp.csr_matrix((np.ones(ne * nv), cells.ravel(),
+                               np.arange(0, ne * nv + 1, nv)), shape=(ne, n))
+    pattern = (incidence.T @ incidence).tocsr()
+    pattern.sort_indices()
+    indptr = pattern.indptr.astype(np.int64)
+    indices = pattern.indices.astype(np.int32 if n < 2**31 else np.int64)
+    keys = np.repeat(np.arange(n, dtype=np.int64), np.diff(indptr)) * n + indices
+    slot = np.searchsorted(keys, (cells[:, :, None] * n + cells[:, None, :]).ravel())
+    return indptr, indices, slot
 
 
-def assemble_blocks(pattern, component, d):
-    """A CSR matrix of vector P1 summed into the node pattern of
+def block_data(pattern, component, d):
+    """The (nnzb, d, d) blocks of vector P1 summed into the node pattern of
     :func:`node_pattern`: ``component(a, b)`` gives the (ne, nv, nv) entries
     of the element matrices between the dofs d·node_i + a and d·node_j + b;
-    each component is summed over the cells by one bincount, into the d × d
-    blocks of a block (BSR) matrix."""
-    indptr, indices, slot = pattern
+    each component is summed over the cells by one bincount."""
+    _, indices, slot = pattern
     nnzb = indices.size
     data = np.empty((nnzb, d, d))
     for a in range(d):
         for b in range(d):
             data[:, a, b] = np.bincount(slot, weights=component(a, b).ravel(), minlength=nnzb)
-    n = (indptr.size - 1) * d
+    return data
+
+
+def block_matrix(pattern, data):
+    """The CSR matrix of blocks ``data`` (nnzb, d, d) on the node pattern."""
+    indptr, indices, _ = pattern
+    n = (indptr.size - 1) * data.shape[1]
     return sp.bsr_matrix((data, indices, indptr), shape=(n, n)).tocsr()
 
 
 def stiffness_parts(mesh, geometry=None):
     """(K_λ, K_μ): ∫ div u div v and ∫ 2 ε(u):ε(v) for vector P1, CSR.
 
-    Both are summed into the one node pattern of :func:`node_pattern`, a
-    component (a, b) at a time (:func:`assemble_blocks`). ``geometry`` is
-    :func:`gradients` of the mesh when the caller has it already."""
+    With g_i the gradients of the barycentric coordinates and |e| the cell
+    measure, the element blocks are (K_λ)_ij^ab = |e| g_i[a] g_j[b] and
+    (K_μ)_ij^ab = |e| (g_i[b] g_j[a] + δ_ab g_i·g_j): the μ block (a, b) is
+    the λ block (b, a) plus δ_ab |e| g_i·g_j. So the cells are summed d² + 1
+    times (:func:`block_data`), not 2 d², into the one node pattern of
+    :func:`node_pattern`. ``geometry`` is :func:`gradients` of the mesh when
+    the caller has it already."""
     g, vol = geometry or gradients(mesh)
     d = g.shape[2]
     gv = g * vol[:, None, None]                       # |e| g_i
-    G = np.einsum("eia,eja->eij", gv, g)              # |e| g_i·g_j
-
-    def lam(a, b):   # |e| g_i[a] g_j[b]
-        return gv[:, :, None, a] * g[:, None, :, b]
-
-    def mu(a, b):    # |e| (δ_ab g_i·g_j + g_i[b] g_j[a])
-        out = gv[:, :, None, b] * g[:, None, :, a]
-        return out + G if a == b else out
-
     pattern = node_pattern(mesh)
-    return assemble_blocks(pattern, lam, d), assemble_blocks(pattern, mu, d)
+    lam = block_data(pattern, lambda a, b: gv[:, :, None, a] * g[:, None, :, b], d)
+    _, indices, slot = pattern
+    G = np.bincount(slot, weights=np.einsum("eia,eja->eij", gv, g).ravel(),
+                    minlength=indices.size)           # Σ_e |e| g_i·g_j
+    mu = lam.transpose(0, 2, 1) + G[:, None, None] * np.eye(d)
+    return block_matrix(pattern, lam), block_matrix(pattern, mu)
 
 
 def strain_operator(mesh, geometry=None):
     """Sparse B (ne·d·d, ndofs): (B u) reshaped (ne, d, d) is ε(u) per cell
-    (``geometry`` as for :func:`stiffness_parts`)."""
+    (``geometry`` as for :func:`stiffness_parts`).
+
+    Row (e, b, c) is ε_bc = ½ (∂_c u_b + ∂_b u_c): of the dof φ_i e_a of
+    cell e it takes ½ (δ_ab g_i[c] + δ_ac g_i[b]), nonzero for a ∈ {b, c}
+    only. Those entries are written straight into the CSR arrays (60 a
+    tetrahedron, not the 108 of all (i, a)): for the 1.9e6 tetrahedra of a
+    1e6-dof box 6 s and 1.5 GB against 13 s and 4 GB with the dense
+    (e, b, c, i, a) array."""
     g, _ = geometry or gradients(mesh)
     ne, nv, d = g.shape
-    eye = np.eye(d)
-    # ε_bc of u = φ_i e_a: ½ (δ_ab g_i[c] + δ_ac g_i[b]), indexed (e, b, c, i, a)
-    eps = 0.5 * (np.einsum("ab,eic->ebcia", eye, g) + np.einsum("ac,eib->ebcia", eye, g))
-    # row (e, b, c) holds the (d+1)·d dofs of cell e once each: CSR directly
-    nnz = ne * d * d * nv * d
-    index = np.int32 if max(nnz, d * mesh.p.shape[1]) < 2**31 else np.int64
-    cols = np.broadcast_to(element_dofs(mesh).astype(index)[:, None, :], (ne, d * d, nv * d))
-    indptr = np.arange(0, nnz + 1, nv * d, dtype=index)
-    B = sp.csr_matrix((eps.reshape(-1), cols.reshape(-1), indptr),
+    dofs = element_dofs(mesh)                        # (ne, nv·d), local i·d + a
+    entries = [(b, c, i, a) for b in range(d) for c in range(d) for i in range(nv)
+               for a in sorted({b, c})]              # row-major: row (b, c), then (i, a)
+    index = np.int32 if max(ne * len(entries), d * mesh.p.shape[1]) < 2**31 else np.int64
+    data = np.empty((ne, len(entries)))
+    cols = np.empty((ne, len(entries)), dtype=index)
+    for k, (b, c, i, a) in enumerate(entries):
+        data[:, k] = 0.5 * ((a == b) * g[:, i, c] + (a == c) * g[:, i, b])
+        cols[:, k] = dofs[:, i * d + a]
+    per_row = [nv * len({b, c}) for b in range(d) for c in range(d)]
+    indptr = np.concatenate([[0], np.cumsum(np.tile(per_row, ne))]).astype(index)
+    B = sp.csr_matrix((data.ravel(), cols.ravel(), indptr),
                       shape=(ne * d * d, d * mesh.p.shape[1]))
     B.eliminate_zeros()
     B.sort_indices()

@@ -140,7 +140,9 @@ def build_problem(scene):
     prescribed = prescribed_displacement(scene, mesh)
     # a node with any held component leaves Γ_C (module adhesive_contact.dirichlet)
     clamped_nodes = np.unique(prescribed.fixed // d)
-    free = np.setdiff1d(np.arange(assembly.ndofs), prescribed.fixed)
+    held = np.zeros(assembly.ndofs, dtype=bool)
+    held[prescribed.fixed] = True
+    free = np.flatnonzero(~held)
     position = np.full(assembly.ndofs, -1)
     position[free] = np.arange(free.size)
 

@@ -13,6 +13,8 @@ Sides are named as scikit-fem does: left/right (x = 0, L_x), bottom/top
 import numpy as np
 from skfem import MeshQuad, MeshTet, MeshTri
 
+from .facets import with_boundaries
+
 #: the named sides of the rectangle (2D) and of the box (3D)
 SIDES = {2: ("left", "right", "bottom", "top"),
          3: ("left", "right", "bottom", "top", "front", "back")}
@@ -46,4 +48,9 @@ def structured_mesh(spec):
         raise ValueError(f"unknown domain {spec.domain!r}")
     if spec.refine:
         mesh = mesh.refined(spec.refine)
-    return mesh.with_boundaries(side_tests(spec.size))
+    # the tests on the boundary facets' midpoints only (scikit-fem's own
+    # facets_satisfying tests every facet: 4.8 of 23 s of building a 1e6-dof box)
+    boundary = mesh.boundary_facets()
+    midpoints = mesh.p[:, mesh.facets[:, boundary]].mean(axis=1)
+    return with_boundaries(mesh, {name: boundary[test(midpoints)]
+                                  for name, test in side_tests(spec.size).items()})

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from skfem import MeshTet, MeshTri
 
-from .facets import facet_index
+from .facets import facet_index, with_boundaries
 
 #: the cell type the mesh is made of, and that of its facets, by dimension
 CELL = {2: "triangle", 3: "tetra"}
@@ -136,4 +136,4 @@ def read_mesh_file(path, dim):
             raise MeshFileError(f"{name!r}: group {group!r} has {FACET[dim]} cells that are "
                                 "not facets of the mesh")
         boundaries[group] = np.unique(index)
-    return mesh.with_boundaries(boundaries) if boundaries else mesh
+    return with_boundaries(mesh, boundaries) if boundaries else mesh
