@@ -324,3 +324,26 @@ def test_fine_contact_facets_find_their_coarse_facet(path, dim):
     assert bary.min() > 0 and bary.max() < 1
     recon = np.einsum("dvn,nv->dn", corners, bary)
     np.testing.assert_allclose(recon, centroid, atol=1e-13)
+
+
+@pytest.mark.parametrize("spec", [
+    MeshSpec(domain="rectangle", size=(2.0, 1.0), cells=(4, 3), pattern="diagonal", refine=1),
+    MeshSpec(domain="rectangle", size=(2.0, 1.0), cells=(4, 3), pattern="cross"),
+    MeshSpec(domain="box", size=(2.0, 1.0, 0.5), cells=(3, 2, 2))])
+def test_builtin_sides_and_facets_equal_scikit_fems_own(spec):
+    """The sides found on the boundary facets alone, and the facets handed
+    over to the named copy, are those scikit-fem finds and builds itself."""
+    from skfem import MeshTet, MeshTri
+
+    from adhesive_contact.meshes.builtin import SIDES, side_tests
+
+    mesh = structured_mesh(spec)
+    fresh = (MeshTri if mesh.dim() == 2 else MeshTet)(mesh.p, mesh.t)
+    np.testing.assert_array_equal(mesh.facets, fresh.facets)
+    np.testing.assert_array_equal(mesh.t2f, fresh.t2f)
+    np.testing.assert_array_equal(mesh.f2t, fresh.f2t)
+    own = fresh.with_boundaries(side_tests(spec.size))
+    assert set(mesh.boundaries) == set(own.boundaries) == set(SIDES[mesh.dim()])
+    for name, facets in own.boundaries.items():
+        assert facets.size > 0
+        np.testing.assert_array_equal(mesh.boundaries[name], facets)
