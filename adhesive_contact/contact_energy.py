@@ -159,7 +159,9 @@ class HessianMap:
                 values.append(v)
         cat = (lambda x: np.concatenate(x) if x else np.zeros(0, dtype=np.int64))
         rows, cols, coefs, values = cat(rows), cat(cols), cat(coefs), cat(values)
-        keys, entry = np.unique(rows * size + cols, return_inverse=True)   # row-major order
+        # row-major keys in 64 bits (the traces' indices are 32-bit, and k·size
+        # passes 2³¹ from 46 341 unknowns on: the free dofs of a large mesh)
+        keys, entry = np.unique(rows.astype(np.int64) * size + cols, return_inverse=True)
         self.indices = (keys % size).astype(np.int32)
         self.indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // size,
                                                                  minlength=size))]).astype(np.int32)

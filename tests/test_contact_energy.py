@@ -95,3 +95,17 @@ def test_hessian_map_equals_the_sparse_products(dim, quadrature):
     np.testing.assert_allclose(HessianMap(N, [], nq, energy.nz)(n).toarray(),
                                (N.T @ sp.diags(n) @ N).toarray(), rtol=0,
                                atol=1e-13 * abs(expected).max())
+
+
+def test_hessian_map_on_a_vector_of_a_million_unknowns():
+    """Φ as a function of all free dofs of a large mesh (the AMG step):
+    the keys k·size + l of its entries pass 2³¹ and must not wrap."""
+    size, nq = 1_000_000, 3
+    cols = np.array([999_990, 999_995, 500_000])
+    N = sp.csr_matrix((np.ones(nq), cols, np.arange(nq + 1)), shape=(nq, size))
+    T = [sp.csr_matrix((np.full(nq, 2.0), cols[::-1], np.arange(nq + 1)), shape=(nq, size))]
+    n, b = np.array([1.0, 2.0, 3.0]), np.array([4.0, 5.0, 6.0])[:, None, None]
+    H = HessianMap(N, T, nq, size)(n, b)
+    expected = N.T @ sp.diags(n) @ N + T[0].T @ sp.diags(b[:, 0, 0]) @ T[0]
+    assert H.shape == (size, size) and H.nnz == 3
+    assert abs(H - expected).max() == 0.0
