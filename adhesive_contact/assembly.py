@@ -172,8 +172,12 @@ class Assembly:
         return np.arange(self.ndofs).reshape(-1, self.dim).T
 
     def stiffness(self, lam, mu):
-        """λ K_λ + μ K_μ, the stiffness of the isotropic tensor (λ, μ)."""
-        return (lam * self.K_lam + mu * self.K_mu).tocsr()
+        """λ K_λ + μ K_μ (CSR), the stiffness of the isotropic tensor (λ, μ):
+        the two share their block pattern, so their data are combined and
+        converted once."""
+        K_lam, K_mu = self.K_lam, self.K_mu
+        return sp.bsr_matrix((lam * K_lam.data + mu * K_mu.data, K_lam.indices, K_lam.indptr),
+                             shape=K_lam.shape).tocsr()
 
     def force(self, lam_field, mu_field):
         """K_λ a + K_μ b: the force of the stress tr ε(a) I + 2 ε(b)."""

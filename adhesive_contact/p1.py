@@ -100,14 +100,18 @@ def block_data(pattern, component, d):
 
 
 def block_matrix(pattern, data):
-    """The CSR matrix of blocks ``data`` (nnzb, d, d) on the node pattern."""
+    """The block (BSR) matrix of blocks ``data`` (nnzb, d, d) on the node
+    pattern: block (r, c) couples the dofs d·r + a and d·c + b."""
     indptr, indices, _ = pattern
     n = (indptr.size - 1) * data.shape[1]
-    return sp.bsr_matrix((data, indices, indptr), shape=(n, n)).tocsr()
+    return sp.bsr_matrix((data, indices, indptr), shape=(n, n))
 
 
 def stiffness_parts(mesh, geometry=None):
-    """(K_λ, K_μ): ∫ div u div v and ∫ 2 ε(u):ε(v) for vector P1, CSR.
+    """(K_λ, K_μ): ∫ div u div v and ∫ 2 ε(u):ε(v) for vector P1, as block
+    (BSR) matrices of d × d blocks on one node pattern (a combination
+    λ K_λ + μ K_μ is then one sum of their data and one conversion to CSR:
+    :meth:`~adhesive_contact.assembly.Assembly.stiffness`).
 
     With g_i the gradients of the barycentric coordinates and |e| the cell
     measure, the element blocks are (K_λ)_ij^ab = |e| g_i[a] g_j[b] and
