@@ -167,7 +167,7 @@ class HessianMap:
                                                                  minlength=size))]).astype(np.int32)
         self.expansion = sp.csr_matrix((values, (entry, coefs)),
                                        shape=(keys.size, nq * (1 + m * m)))
-        self.nq, self.m, self.size = nq, m, size
+        self.nq, self.size = nq, size
 
     def __call__(self, normal=None, blocks=None):
         """H (csr) for n = ``normal`` (nq,) and b = ``blocks`` (nq, m, m);
