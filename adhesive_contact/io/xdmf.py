@@ -4,11 +4,12 @@ strain σ_zz included) and von_mises; ``contact.xdmf`` (+ ``.h5``) on the
 contact facets (only with contact facets), whose points are the facets'
 vertices alone (:func:`contact_points`, in increasing mesh index), with
 cell data beta and point data u, and at the contact nodes (0 at a clamped
-vertex, which carries no contact unknown): traction (global, 3 components), normal_traction (positive in
-compression), tangential_traction (nodal tangent frames, padded to 3),
-u_normal, slip |u_τ|, on_wall (0/1) and state, an integer: 0 separated,
-1 compliance, 2 wall, 3 stick, 4 slip
-(:func:`adhesive_contact.postprocess.contact_state_code`). Without h5py the data is written inline in the XDMF files."""
+vertex, which carries no contact unknown): traction (global, 3
+components), normal_traction (positive in compression),
+tangential_traction (nodal tangent frames, padded to 3), u_normal, slip
+|u_τ|, on_wall (0/1) and state, an integer: 0 separated, 1 compliance,
+2 wall, 3 stick, 4 slip (:func:`adhesive_contact.postprocess.contact_state_code`).
+Without h5py the data is written inline in the XDMF files."""
 
 from pathlib import Path
 
