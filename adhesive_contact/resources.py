@@ -195,7 +195,8 @@ def estimate(scene, memory_limit=None):
     history = 8.0 * levels * (dofs * (2 if _function_kernel(scene) else 1) + 2 * contact_nodes)
     memory = (BASE_BYTES + BYTES_PER_DOF * dofs + 4 * BYTES_PER_ENTRY * nnz + factors
               + DENSE_BYTES * dense**2 + history)
-    step = (SECONDS_PER_STEP + SECONDS_PER_DOF_STEP * dofs + NEWTON_ITERATIONS * dense**3 / (3 * FLOPS)
+    step = (SECONDS_PER_STEP + SECONDS_PER_DOF_STEP * dofs
+            + NEWTON_ITERATIONS * dense**3 / (3 * FLOPS)
             + (1e-9 * dofs * levels / 2 if _function_kernel(scene) else 0.0))
     setup = SECONDS_PER_DOF_SETUP[d] * dofs * max(1.0, dofs / 1e5) ** SETUP_GROWTH[d]
     if full_system:

@@ -149,8 +149,7 @@ class StepOperators:
                 coupled(*elastic)
                 shift = frames(dlam, dmu)[free][:, free]
             else:   # with PARDISO the t = 0 operator forms S as cheaply as it applies it
-                nearby = (None if isinstance(step, PartialCondensation)
-                                 else step.S.matrix)
+                nearby = None if isinstance(step, PartialCondensation) else step.S.matrix
                 initial = step_operator(*elastic, nearby=nearby)
         schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
         return cls(rotation=R, free=free, initial=initial, step=step,
@@ -215,4 +214,3 @@ def _newton_unknowns(problem):
     if problem.scene.solver.method not in FULL_SYSTEM:
         return 0
     return int(problem.contact_positions.size)
-

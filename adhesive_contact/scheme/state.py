@@ -24,7 +24,7 @@ class State:
     n: int
     t: float
     beta: np.ndarray     # (nf,) β_n per contact facet
-    z: np.ndarray        # the step's unknowns: the contact unknowns (nodal frames), or all free dofs
+    z: np.ndarray        # the step's unknowns: contact unknowns (nodal frames) or all free dofs
     u: np.ndarray        # (ndofs,) u_n, Cartesian
     frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes
     memory: object       # the run's memory history (adhesive_contact.memory)
