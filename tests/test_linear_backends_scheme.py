@@ -75,6 +75,8 @@ def test_linear_tol_sets_the_accuracy_of_amg():
     direct = _run(scene, linear="superlu")
     direct_loose = _run(scene, linear="superlu", linear_tol=1e-4)
     assert np.array_equal(direct.u, direct_loose.u)
+    # no Γ_C: no step method ran
+    assert direct.timings["contact_solve"] == 0.0 < direct.timings["stepping"]
 
 
 def test_amg_with_contact_is_as_accurate_as_the_step_tolerance():

@@ -59,6 +59,7 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
                "factorisation": operators.factor_seconds,
                "schur": operators.schur_seconds,
                "stepping": t_end - t_loop,
+               "contact_solve": contact.seconds if contact is not None else 0.0,
                "total": problem.assembly_seconds + (t_end - t0)}
     message = {SUCCESS: "all steps converged", STEP_FAILED: str(failure),
                STOPPED: f"stopped after step {state.n} (t = {state.t:g})"}[status]

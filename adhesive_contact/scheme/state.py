@@ -7,6 +7,7 @@ belongs to one run: the built-once :class:`~adhesive_contact.problem.Problem`
 is never changed by a run.
 """
 
+import time
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -70,6 +71,7 @@ class ContactStep:
         self.unknowns = self.energy.unknowns
         self.size = self.energy.nz
         self.kink = None
+        self.seconds = 0.0   # spent in the step method, over all levels so far
         if problem.friction is not None:
             # every friction law gets its slip directions held (κ_a = 0 without a
             # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ
@@ -90,7 +92,10 @@ class ContactStep:
             options = replace(options, tol=max(options.tol * tighter, 1e-14))
         upper = np.full(self.size, np.inf)
         upper[self.unknowns] = problem.upper_bound(n)
-        return minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
+        start = time.perf_counter()
+        result = minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
+        self.seconds += time.perf_counter() - start
+        return result
 
     def options(self, S):
         """The StepOptions of a step with matrix S: the scene's tolerances and,
