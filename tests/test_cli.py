@@ -2,6 +2,7 @@
 
 import json
 import tomllib
+import zipfile
 from importlib import resources
 
 import meshio
@@ -99,6 +100,14 @@ def test_npz_has_the_firm_keys_and_shapes(solved):
         top = data["points"][:, 1] == 1.0
         assert np.all(data["u"][:, top] == 0.0)
         assert np.abs(data["u"][-1]).max() > 0
+
+
+def test_the_history_is_stored_uncompressed_and_the_rest_compressed(solved):
+    _, out, _ = solved
+    with zipfile.ZipFile(out / "solution.npz") as archive:
+        kinds = {entry.filename: entry.compress_type for entry in archive.infolist()}
+    assert kinds.pop("u.npy") == zipfile.ZIP_STORED
+    assert set(kinds.values()) == {zipfile.ZIP_DEFLATED} and "beta.npy" in kinds
 
 
 def test_summary_has_one_record_per_level(solved):
