@@ -7,9 +7,11 @@ An isotropic tensor C ε = λ tr(ε) I + 2 μ ε has the stiffness
 
 so the elastic tensor A, the memory tensors C_m and the step matrix
 a_n = A + k R(0) of docs/scheme.md ('What a step solves') are all combinations of two matrices
-assembled once. Loads ⟨f(t), v⟩ = (f_0, v)_Ω + (f_N, v)_{Γ_N} are a fixed
-sparse map applied to the load expressions evaluated at fixed quadrature
-points, so a step costs one evaluation and one sparse product.
+assembled once. Loads ⟨f(t), v⟩ = (f_0, v)_Ω + (f_N, v)_{Γ_N} are the
+load expressions evaluated at fixed quadrature points and contracted with
+the test functions' values there (:class:`~adhesive_contact.p1.CellLoad`
+in Ω, a fixed sparse map on Γ_N), so a step costs one evaluation and one
+contraction; a body force constant in space costs neither.
 """
 
 import numpy as np
@@ -26,7 +28,7 @@ from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
 
 from .expressions import coordinates
-from .p1 import cell_load_map, gradients, stiffness_parts, strain_operator
+from .p1 import CellLoad, gradients, stiffness_parts, strain_operator
 
 
 @BilinearForm
@@ -108,6 +110,11 @@ class vector_of:
     def __call__(self, x, y=None, z=None, t=0.0):
         return np.stack([e(x, y, z, t=t) for e in self.expressions])
 
+    @property
+    def spatial(self):
+        """False when no component uses x, y or z."""
+        return any(e.uses & {"x", "y", "z"} for e in self.expressions)
+
 
 def is_zero(expressions):
     return all(e.is_constant and float(e(0.0)) == 0.0 for e in expressions)
@@ -115,6 +122,17 @@ def is_zero(expressions):
 
 #: the exactness of the rules on which LoadMap evaluates loads
 LOAD_INTORDER = 4
+
+
+class SurfaceLoad:
+    """⟨f, v⟩ on facets: Σ_c M_c f_c(x_q) with the sparse maps M_c of
+    :func:`quadrature_load_map`, at its points ``points``."""
+
+    def __init__(self, basis):
+        self.maps, self.points = quadrature_load_map(basis)
+
+    def __call__(self, values):
+        return sum(m @ v for m, v in zip(self.maps, values))
 
 
 class LoadMap:
@@ -126,6 +144,12 @@ class LoadMap:
     body : vector field f_0(x, y, z, t) -> (d, ...), or None
     surface : list of (facets, vector field) pairs (tractions f_N on Γ_N
         sides, and the manufactured load f_C on Γ_C)
+
+    ``parts`` lists (field, load, points): ``load`` maps the field's
+    values at ``points`` (d, nq) to the load vector. A body force whose
+    expressions do not use x, y, z (``field.spatial`` False) is evaluated
+    at one point and spread by ∫_Ω φ_i (:meth:`CellLoad.uniform`): exact,
+    and no evaluation over the cells' points.
     """
 
     def __init__(self, mesh, body, surface, intorder=None):
@@ -134,18 +158,20 @@ class LoadMap:
         elem = vector_element(d)
         self.parts = []
         if body is not None:
-            self.parts.append((body, *cell_load_map(mesh, intorder)))
+            load = CellLoad(mesh, intorder)
+            self.parts.append((body, load, load.points))
         for facets, field in surface:
-            basis = FacetBasis(mesh, elem, facets=facets, intorder=intorder)
-            self.parts.append((field, *quadrature_load_map(basis)))
+            load = SurfaceLoad(FacetBasis(mesh, elem, facets=facets, intorder=intorder))
+            self.parts.append((field, load, load.points))
         self.ndofs = d * mesh.p.shape[1]
 
     def __call__(self, t):
         f = np.zeros(self.ndofs)
-        for field, maps, x in self.parts:
-            values = field(*coordinates(x), t=t)
-            for c, m in enumerate(maps):
-                f += m @ values[c]
+        for field, load, x in self.parts:
+            if isinstance(load, CellLoad) and not getattr(field, "spatial", True):
+                f += load.uniform(field(*coordinates(x[:, :1]), t=t)[:, 0])
+            else:
+                f += load(field(*coordinates(x), t=t))
         return f
 
 

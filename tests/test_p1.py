@@ -8,13 +8,16 @@ from skfem import Basis, MeshTet, MeshTri, asm
 
 from adhesive_contact import p1
 from adhesive_contact.assembly import (
+    LoadMap,
     divergence_product,
     quadrature_load_map,
     stiffness_basis,
     strain_map,
     strain_product,
     vector_element,
+    vector_of,
 )
+from adhesive_contact.expressions import compile_expression
 
 
 def distorted(mesh):
@@ -52,8 +55,39 @@ def test_stiffness_parts_match_the_forms(name):
 def test_strain_and_load_maps_match_scikit_fem(name):
     mesh = MESHES[name]
     assert relative(p1.strain_operator(mesh), strain_map(stiffness_basis(mesh))) < 1e-13
-    maps, points = p1.cell_load_map(mesh, 4)
+    load = p1.CellLoad(mesh, 4)
     maps0, points0 = quadrature_load_map(Basis(mesh, vector_element(mesh.dim()), intorder=4))
-    for m, m0 in zip(maps, maps0):
-        assert relative(m, m0) < 1e-13
-    np.testing.assert_allclose(points, points0, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(load.points, points0, rtol=0, atol=1e-14)
+    # the contraction against scikit-fem's sparse maps, on arbitrary values
+    values = np.random.default_rng(0).standard_normal(load.points.shape)
+    expected = sum(m0 @ v for m0, v in zip(maps0, values))
+    assert np.abs(load(values) - expected).max() <= 1e-13 * np.abs(expected).max()
+    # a field constant in space: f_c ∫ φ_i, the same as evaluated everywhere
+    f = np.arange(1.0, mesh.dim() + 1.0)
+    everywhere = load(np.broadcast_to(f[:, None], load.points.shape))
+    assert np.abs(load.uniform(f) - everywhere).max() <= 1e-13 * np.abs(everywhere).max()
+    # ∫ φ_i sums to |Ω|
+    assert load.mass.sum() == pytest.approx(p1.gradients(mesh)[1].sum(), rel=1e-13)
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_a_body_force_constant_in_space_skips_the_points(name, monkeypatch):
+    """A body force that uses t only is evaluated at one point and spread by
+    ∫ φ_i: the load of the same field evaluated at every quadrature point
+    (the same expression plus 0·x, which uses x), to round-off; and the
+    cells' points are never evaluated."""
+    mesh = MESHES[name]
+    d = mesh.dim()
+    texts = ["3*t", "-40*t", "sin(t)"][:d]
+    field = vector_of([compile_expression(e) for e in texts])
+    spatial = vector_of([compile_expression(f"{e} + 0*x") for e in texts])
+    assert not field.spatial and spatial.spatial
+    expected = LoadMap(mesh, spatial, [])(0.7)
+    evaluated = []
+    call = vector_of.__call__
+    monkeypatch.setattr(vector_of, "__call__",
+                        lambda self, x, *a, **k: evaluated.append(np.size(x)) or call(
+                            self, x, *a, **k))
+    got = LoadMap(mesh, field, [])(0.7)
+    assert evaluated == [1]
+    assert np.abs(got - expected).max() <= 1e-13 * np.abs(expected).max()
