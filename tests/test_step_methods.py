@@ -126,10 +126,12 @@ def test_plain_newton_cycles_where_the_globalised_one_converges():
     between active sets; the line search of "newton" settles them."""
     _, ref = run("newton", (TRESCA,), SHEAR)
     _, sol = run("newton-plain", (TRESCA,), SHEAR)
-    # (the count depends on round-off: 7 with PARDISO's S, 12 with SuperLU's)
+    # (the count depends on round-off: 7 with PARDISO's S, 12 with SuperLU's;
+    # so does the step at which the full steps start to cycle: the first or
+    # the second of the two, as the load is summed in one order or another)
     assert ref.success and ref.iterations.max() <= 15
     assert sol.status == STEP_FAILED and sol.failure.result.status == MAX_ITERATIONS
-    assert sol.failure.result.residual > 1e-3 and sol.t.size == 1
+    assert sol.failure.result.residual > 1e-3 and sol.t.size == sol.failure.n
 
 
 def test_plain_newton_failure_on_the_command_line(tmp_path):
@@ -141,7 +143,8 @@ def test_plain_newton_failure_on_the_command_line(tmp_path):
     assert len(errors) == 1 and "no convergence in 50 iterations" in errors[0]
     assert "Traceback" not in result.stderr
     summary = strict_json(tmp_path / "out" / "summary.json")
-    assert summary["run"]["partial"] and len(summary["steps"]) == 1
+    # the levels before the failed step (which of the two: see the test above)
+    assert summary["run"]["partial"] and len(summary["steps"]) == summary["run"]["failed_step"]
     assert summary["scene"]["solver"]["method"] == "newton-plain"
 
 
