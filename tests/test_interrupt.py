@@ -74,15 +74,22 @@ def test_failure_at_the_first_level_writes_nothing(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
 
 
+def default_sigint():
+    """In the child before it runs: SIGINT's default disposition."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def interrupt_when(args, cwd, ready, timeout=120):
     """Run ``adhcontact args`` in its own process group, send the group
     SIGINT (what Ctrl-C in a terminal does) once ``ready()`` holds, and
     return (exit code, stderr, whether a process of the group outlived it
     by 5 s)."""
     code = "from adhesive_contact_cli.main import main; main()"
+    # SIGINT as a terminal leaves it: a shell without job control starts
+    # background commands with SIGINT ignored, and Python then keeps it so
     proc = subprocess.Popen([sys.executable, "-c", code, *args], cwd=cwd,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=default_sigint)
     deadline = time.monotonic() + timeout
     while not ready():
         assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read()
