@@ -28,7 +28,7 @@ from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
 
 from .expressions import coordinates
-from .p1 import CellLoad, gradients, stiffness_parts, strain_operator
+from .p1 import CellLoad, gradients, stiffness_parts, strain_operator, symmetric_pairs
 
 
 @BilinearForm
@@ -211,10 +211,17 @@ class Assembly:
 
     def cell_strain(self, u):
         """ε(u) per cell, shape (ncells, d, d)."""
-        return (self.strain @ u).reshape(-1, self.dim, self.dim)
+        d = self.dim
+        pairs, full = symmetric_pairs(d)
+        return (self.strain @ u).reshape(-1, len(pairs))[:, full].reshape(-1, d, d)
 
     def cell_stress(self, lam_field, mu_field):
         """σ = tr ε(a) I + 2 ε(b) per cell (ncells, d, d), and tr ε(a) (ncells,):
         in plane strain (ε_zz = 0) the latter is σ_zz."""
-        tr = np.trace(self.cell_strain(lam_field), axis1=1, axis2=2)
-        return tr[:, None, None] * np.eye(self.dim) + 2.0 * self.cell_strain(mu_field), tr
+        d = self.dim
+        pairs, full = symmetric_pairs(d)
+        diagonal = [pairs.index((a, a)) for a in range(d)]
+        tr = (self.strain @ lam_field).reshape(-1, len(pairs))[:, diagonal].sum(axis=1)
+        stress = 2.0 * (self.strain @ mu_field).reshape(-1, len(pairs))
+        stress[:, diagonal] += tr[:, None]
+        return stress[:, full].reshape(-1, d, d), tr
