@@ -130,6 +130,7 @@ class SurfaceLoad:
 
     def __init__(self, basis):
         self.maps, self.points = quadrature_load_map(basis)
+        self.anchor = self.points[:, :1]
 
     def __call__(self, values):
         return sum(m @ v for m, v in zip(self.maps, values))
@@ -145,11 +146,11 @@ class LoadMap:
     surface : list of (facets, vector field) pairs (tractions f_N on Γ_N
         sides, and the manufactured load f_C on Γ_C)
 
-    ``parts`` lists (field, load, points): ``load`` maps the field's
-    values at ``points`` (d, nq) to the load vector. A body force whose
+    ``parts`` lists (field, load) pairs: ``load`` maps the field's values
+    at ``load.points`` (d, nq) to the load vector. A body force whose
     expressions do not use x, y, z (``field.spatial`` False) is evaluated
     at one point and spread by ∫_Ω φ_i (:meth:`CellLoad.uniform`): exact,
-    and no evaluation over the cells' points.
+    and the cells' points are never made.
     """
 
     def __init__(self, mesh, body, surface, intorder=None):
@@ -158,20 +159,19 @@ class LoadMap:
         elem = vector_element(d)
         self.parts = []
         if body is not None:
-            load = CellLoad(mesh, intorder)
-            self.parts.append((body, load, load.points))
+            self.parts.append((body, CellLoad(mesh, intorder)))
         for facets, field in surface:
             load = SurfaceLoad(FacetBasis(mesh, elem, facets=facets, intorder=intorder))
-            self.parts.append((field, load, load.points))
+            self.parts.append((field, load))
         self.ndofs = d * mesh.p.shape[1]
 
     def __call__(self, t):
         f = np.zeros(self.ndofs)
-        for field, load, x in self.parts:
+        for field, load in self.parts:
             if isinstance(load, CellLoad) and not getattr(field, "spatial", True):
-                f += load.uniform(field(*coordinates(x[:, :1]), t=t)[:, 0])
+                f += load.uniform(field(*coordinates(load.anchor), t=t)[:, 0])
             else:
-                f += load(field(*coordinates(x), t=t))
+                f += load(field(*coordinates(load.points), t=t))
         return f
 
 

@@ -15,6 +15,7 @@ same quantities from scikit-fem's forms (:mod:`adhesive_contact.assembly`)
 agree to round-off (a test); these kernels are several times faster.
 """
 
+import functools
 from math import factorial
 
 import numpy as np
@@ -187,7 +188,8 @@ class CellLoad:
     for the 1.9e6 tetrahedra of a 1e6-dof box at nq = 11.
 
     ``points`` (d, ne·nq), ordered cell by cell (column e·nq + q), are where
-    f is evaluated; a field constant in space needs only :meth:`uniform`.
+    f is evaluated, made on first use; a field constant in space needs only
+    :meth:`uniform` and its value at one point of Ω, ``anchor`` (d, 1).
     """
 
     def __init__(self, mesh, intorder):
@@ -197,12 +199,18 @@ class CellLoad:
         self.phi = np.vstack([1.0 - X.sum(axis=0), X])                   # (d+1, nq)
         _, vol = gradients(mesh)
         self.dx = (vol * factorial(d))[:, None] * W[None, :]            # (ne, nq)
-        self.points = np.einsum("ien,iq->enq", p[:, t].transpose(1, 0, 2),
-                                self.phi).reshape(d, -1)
-        self.cells, self.npoints, self.dim = t, p.shape[1], d
+        self.coordinates, self.cells, self.npoints, self.dim = p, t, p.shape[1], d
+        self.anchor = p[:, :1]
         # ∫_Ω φ_i: the load of a unit field, for fields constant in space
         self.mass = np.bincount(t.ravel(), (self.dx @ self.phi.T).T.ravel(),
                                 minlength=p.shape[1])
+
+    @functools.cached_property
+    def points(self):
+        """The quadrature points x_eq (d, ne·nq): 500 MB for a 1e6-dof box."""
+        p, t = self.coordinates, self.cells
+        return np.einsum("ien,iq->enq", p[:, t].transpose(1, 0, 2),
+                         self.phi).reshape(self.dim, -1)
 
     def __call__(self, values):
         """F (d·npoints,) of f_c(x_eq) = ``values[c]`` (d, ne·nq)."""

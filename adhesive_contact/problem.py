@@ -224,7 +224,7 @@ def build_problem(scene):
             beta0 = _facet_mean(mesh, boundary, exact.beta)
     loads = LoadMap(mesh, body, surface)
     if scene.exact is not None:
-        checks = [[("exact", field)] for field, _, _ in loads.parts]
+        checks = [[("exact", field)] for field, _ in loads.parts]
     check_loads(checks, loads, times)
     return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free,
                    prescribed=prescribed, boundary=boundary,

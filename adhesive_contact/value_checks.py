@@ -61,16 +61,20 @@ def check_finite(key, field, points, times):
 
 
 def check_loads(keyed_fields, loads, times):
-    """The loads finite at the quadrature points of the load map.
+    """The loads finite at the quadrature points of the load map (at one
+    point for an expression that does not use x, y, z: its value is the
+    same everywhere).
 
     ``keyed_fields`` lists, parallel to ``loads.parts``, the fields to check
     there as (key, field) pairs: a scene's expressions one component at a
     time, so that the key names the component."""
     sample = sample_times(times)
-    for fields, (_, _, x) in zip(keyed_fields, loads.parts):
-        points = x.reshape(x.shape[0], -1)
+    for fields, (_, load) in zip(keyed_fields, loads.parts):
         for key, field in fields:
-            check_finite(key, field, points, sample)
+            uses = getattr(field, "uses", None)
+            spatial = uses is None or bool(uses & {"x", "y", "z"})
+            points = load.points if spatial else load.anchor
+            check_finite(key, field, points.reshape(points.shape[0], -1), sample)
 
 
 def check_kernel(key, r, k, steps):

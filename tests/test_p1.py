@@ -4,9 +4,10 @@ same few terms per entry in a different order)."""
 
 import numpy as np
 import pytest
+from conftest import scene_dict
 from skfem import Basis, MeshTet, MeshTri, asm
 
-from adhesive_contact import p1
+from adhesive_contact import build_problem, p1, scene_from_dict
 from adhesive_contact.assembly import (
     LoadMap,
     divergence_product,
@@ -96,6 +97,17 @@ def test_a_body_force_constant_in_space_skips_the_points(name, monkeypatch):
     monkeypatch.setattr(vector_of, "__call__",
                         lambda self, x, *a, **k: evaluated.append(np.size(x)) or call(
                             self, x, *a, **k))
-    got = LoadMap(mesh, field, [])(0.7)
+    loads = LoadMap(mesh, field, [])
+    got = loads(0.7)
     assert evaluated == [1]
     assert np.abs(got - expected).max() <= 1e-13 * np.abs(expected).max()
+    assert "points" not in vars(loads.parts[0][1])   # never made
+
+
+@pytest.mark.parametrize("body, made", [(["0", "-10*t"], False), (["0", "-10*t*x"], True)])
+def test_a_scene_makes_the_cells_points_only_for_a_body_force_varying_in_space(body, made):
+    """build_problem checks the loads finite: a body force constant in space
+    at one point, one that uses x at every quadrature point."""
+    problem = build_problem(scene_from_dict(scene_dict({"loads.body": body})))
+    (field, load), = problem.loads.parts
+    assert ("points" in vars(load)) == made
