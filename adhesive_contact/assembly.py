@@ -111,9 +111,9 @@ class vector_of:
         return np.stack([e(x, y, z, t=t) for e in self.expressions])
 
     @property
-    def spatial(self):
-        """False when no component uses x, y or z."""
-        return any(e.uses & {"x", "y", "z"} for e in self.expressions)
+    def depends_on_space(self):
+        """True if a component uses x, y or z."""
+        return any(e.depends_on_space for e in self.expressions)
 
 
 def is_zero(expressions):
@@ -148,7 +148,7 @@ class LoadMap:
 
     ``parts`` lists (field, load) pairs: ``load`` maps the field's values
     at ``load.points`` (d, nq) to the load vector. A body force whose
-    expressions do not use x, y, z (``field.spatial`` False) is evaluated
+    expressions do not use x, y, z (``field.depends_on_space`` False) is evaluated
     at one point and spread by ∫_Ω φ_i (:meth:`CellLoad.uniform`): exact,
     and the cells' points are never made.
     """
@@ -168,7 +168,7 @@ class LoadMap:
     def __call__(self, t):
         f = np.zeros(self.ndofs)
         for field, load in self.parts:
-            if isinstance(load, CellLoad) and not getattr(field, "spatial", True):
+            if isinstance(load, CellLoad) and not getattr(field, "depends_on_space", True):
                 f += load.uniform(field(*coordinates(load.anchor), t=t)[:, 0])
             else:
                 f += load(field(*coordinates(load.points), t=t))
@@ -185,7 +185,8 @@ class Assembly:
         self.dim = mesh.dim()
         geometry = gradients(mesh)   # the barycentric gradients, shared
         self.K_lam, self.K_mu = stiffness_parts(mesh, geometry)
-        self.strain = strain_operator(mesh, geometry)
+        self.strain = strain_operator(mesh, geometry)   # the entries b ≤ c of ε
+        self.pairs, self.full = symmetric_pairs(self.dim)
 
     @property
     def ndofs(self):
@@ -212,16 +213,14 @@ class Assembly:
     def cell_strain(self, u):
         """ε(u) per cell, shape (ncells, d, d)."""
         d = self.dim
-        pairs, full = symmetric_pairs(d)
-        return (self.strain @ u).reshape(-1, len(pairs))[:, full].reshape(-1, d, d)
+        return (self.strain @ u).reshape(-1, len(self.pairs))[:, self.full].reshape(-1, d, d)
 
     def cell_stress(self, lam_field, mu_field):
         """σ = tr ε(a) I + 2 ε(b) per cell (ncells, d, d), and tr ε(a) (ncells,):
         in plane strain (ε_zz = 0) the latter is σ_zz."""
-        d = self.dim
-        pairs, full = symmetric_pairs(d)
+        d, pairs = self.dim, self.pairs
         diagonal = [pairs.index((a, a)) for a in range(d)]
         tr = (self.strain @ lam_field).reshape(-1, len(pairs))[:, diagonal].sum(axis=1)
         stress = 2.0 * (self.strain @ mu_field).reshape(-1, len(pairs))
         stress[:, diagonal] += tr[:, None]
-        return stress[:, full].reshape(-1, d, d), tr
+        return stress[:, self.full].reshape(-1, d, d), tr

@@ -246,6 +246,11 @@ class Expression:
         """True if the expression uses t."""
         return 't' in self.uses
 
+    @property
+    def depends_on_space(self):
+        """True if the expression uses x, y or z."""
+        return bool(self.uses & {'x', 'y', 'z'})
+
     def __call__(self, x, y=None, z=None, t=0.0):
         """Evaluate at points ``(x, y, z)`` and time ``t``.
 

@@ -71,9 +71,7 @@ def check_loads(keyed_fields, loads, times):
     sample = sample_times(times)
     for fields, (_, load) in zip(keyed_fields, loads.parts):
         for key, field in fields:
-            uses = getattr(field, "uses", None)
-            spatial = uses is None or bool(uses & {"x", "y", "z"})
-            points = load.points if spatial else load.anchor
+            points = load.points if getattr(field, "depends_on_space", True) else load.anchor
             check_finite(key, field, points.reshape(points.shape[0], -1), sample)
 
 

@@ -90,7 +90,7 @@ def test_a_body_force_constant_in_space_skips_the_points(name, monkeypatch):
     texts = ["3*t", "-40*t", "sin(t)"][:d]
     field = vector_of([compile_expression(e) for e in texts])
     spatial = vector_of([compile_expression(f"{e} + 0*x") for e in texts])
-    assert not field.spatial and spatial.spatial
+    assert not field.depends_on_space and spatial.depends_on_space
     expected = LoadMap(mesh, spatial, [])(0.7)
     evaluated = []
     call = vector_of.__call__
