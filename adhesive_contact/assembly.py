@@ -187,6 +187,7 @@ class Assembly:
         self.K_lam, self.K_mu = stiffness_parts(mesh, geometry)
         self.strain = strain_operator(mesh, geometry)   # the entries b ≤ c of ε
         self.pairs, self.full = symmetric_pairs(self.dim)
+        self.diagonal = [self.pairs.index((a, a)) for a in range(self.dim)]
 
     @property
     def ndofs(self):
@@ -210,17 +211,18 @@ class Assembly:
         """K_λ a + K_μ b: the force of the stress tr ε(a) I + 2 ε(b)."""
         return self.K_lam @ lam_field + self.K_mu @ mu_field
 
+    def _strain_entries(self, u):
+        """ε(u) per cell at the entries b ≤ c, (ncells, d(d+1)/2)."""
+        return (self.strain @ u).reshape(-1, len(self.pairs))
+
     def cell_strain(self, u):
         """ε(u) per cell, shape (ncells, d, d)."""
-        d = self.dim
-        return (self.strain @ u).reshape(-1, len(self.pairs))[:, self.full].reshape(-1, d, d)
+        return self._strain_entries(u)[:, self.full].reshape(-1, self.dim, self.dim)
 
     def cell_stress(self, lam_field, mu_field):
         """σ = tr ε(a) I + 2 ε(b) per cell (ncells, d, d), and tr ε(a) (ncells,):
         in plane strain (ε_zz = 0) the latter is σ_zz."""
-        d, pairs = self.dim, self.pairs
-        diagonal = [pairs.index((a, a)) for a in range(d)]
-        tr = (self.strain @ lam_field).reshape(-1, len(pairs))[:, diagonal].sum(axis=1)
-        stress = 2.0 * (self.strain @ mu_field).reshape(-1, len(pairs))
-        stress[:, diagonal] += tr[:, None]
-        return stress[:, self.full].reshape(-1, d, d), tr
+        tr = self._strain_entries(lam_field)[:, self.diagonal].sum(axis=1)
+        stress = 2.0 * self._strain_entries(mu_field)
+        stress[:, self.diagonal] += tr[:, None]
+        return stress[:, self.full].reshape(-1, self.dim, self.dim), tr

@@ -31,14 +31,12 @@ beside this script and prints the two rows.
 import argparse
 import csv
 import resource
-import shutil
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-from machine import describe  # studies/bench/machine.py, beside this script
+from machine import adhcontact, describe  # studies/bench/machine.py, beside this script
 
 HERE = Path(__file__).resolve().parent
 SCENE = HERE / "conmech_setup0.toml"
@@ -51,7 +49,7 @@ CONMECH = {   # quoted in issue #8 from conmech's paper/repository: NOT measured
 
 def whole_process(scene, repeats=REPEATS):
     """(fastest wall seconds, peak RSS in MB) of ``adhcontact solve`` runs."""
-    cli = shutil.which("adhcontact", path=str(Path(sys.executable).parent)) or "adhcontact"
+    cli = adhcontact()
     seconds = []
     for _ in range(repeats):
         with tempfile.TemporaryDirectory() as out:

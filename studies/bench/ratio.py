@@ -32,15 +32,13 @@ script and prints one row per dimension.
 import argparse
 import csv
 import json
-import shutil
 import statistics
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-from machine import describe  # studies/bench/machine.py, beside this script
+from machine import adhcontact, describe  # studies/bench/machine.py, beside this script
 
 HERE = Path(__file__).resolve().parent
 SCENES = {2: ("strip", 1.3), 3: ("box", 1.5)}   # dim -> (scene name, the issue's target)
@@ -51,7 +49,7 @@ FIELDS = ("dim", "dofs", "contact_unknowns", "steps", "repeats", "full_s", "elas
 
 def run(scene):
     """(wall seconds, summary.json) of one ``adhcontact solve`` of ``scene``."""
-    cli = shutil.which("adhcontact", path=str(Path(sys.executable).parent)) or "adhcontact"
+    cli = adhcontact()
     with tempfile.TemporaryDirectory() as folder:
         out = Path(folder) / "out"
         t0 = time.perf_counter()
