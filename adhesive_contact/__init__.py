@@ -5,9 +5,9 @@ Euler bonding) on scikit-fem. See docs/model.md for the mathematics."""
 
 from .expressions import ExpressionError, compile_expression
 from .io import OutputFolderError, load_solution, write_xdmf
-from .postprocess import STATE_NAMES, contact_state_codes, contact_traction, total_contact_force
+from .postprocess import (STATE_NAMES, contact_state_codes, contact_traction, reaction_sides,
+                          reactions, total_contact_force)
 from .problem import Problem, build_problem
-from .reactions import reaction_sides, reactions
 from .scene import Scene, SceneError, load_scene, parse_scene, scene_from_dict
 from .scheme import Solution, StepFailure, solve
 

@@ -139,7 +139,7 @@ def _file_counts(scene):
     """(nodes, cells, contact nodes) of a file mesh after its refinements: the
     file's own counts (read by meshio, not built) times 2^d per refinement;
     the contact nodes bounded by a boundary's share, nodes^((d−1)/d) per side."""
-    from .meshes.gmsh_file import MeshFileError, _read
+    from .fem.meshes.gmsh_file import MeshFileError, _read
 
     d, spec = scene.dim, scene.mesh
     try:

@@ -26,12 +26,12 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .bonding import INTEGRATORS
+from .scheme.bonding import INTEGRATORS
 from .expressions import ExpressionError, compile_expression
 from .laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
 from .linear_solvers import METHODS
 from .linear_solvers.pardiso import available as pardiso_available
-from .manufactured import symbolic_problem
+from .verification.manufactured import symbolic_problem
 from .step_methods import METHODS as STEP_METHODS
 
 

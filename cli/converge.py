@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
 import numpy as np
 from matplotlib.ticker import NullFormatter  # noqa: E402
 
-from adhesive_contact.convergence import PARAMS, level_scene
+from adhesive_contact.verification.levels import PARAMS, level_scene
 from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     ConvergenceStudy,

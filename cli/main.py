@@ -152,7 +152,7 @@ def solve_command(scene, out, force, quiet):
     from adhesive_contact import solve
     from adhesive_contact.io import StreamingRecorder
     from adhesive_contact.postprocess import beta_mean
-    from adhesive_contact.sanity import magnitude_warnings
+    from adhesive_contact.problem.warnings import magnitude_warnings
     from adhesive_contact.scheme import STOPPED
 
     from .output import staged_output, write_results

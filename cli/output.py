@@ -28,7 +28,7 @@ from pathlib import Path
 
 from adhesive_contact.io import write_npz, write_xdmf
 from adhesive_contact.resources import estimate
-from adhesive_contact.sanity import magnitude_warnings
+from adhesive_contact.problem.warnings import magnitude_warnings
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 

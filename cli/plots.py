@@ -30,7 +30,7 @@ from adhesive_contact.postprocess import (  # noqa: E402
     normal_traction,
     tangential_traction,
 )
-from adhesive_contact.reactions import (  # noqa: E402
+from adhesive_contact.postprocess import (  # noqa: E402
     applied_traction,
     prescribed_history,
     reaction_sides,

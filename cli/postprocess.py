@@ -6,7 +6,7 @@ this module only formats them.
 import numpy as np
 
 from adhesive_contact.postprocess import beta_mean, total_contact_force
-from adhesive_contact.reactions import reaction_sides, reactions
+from adhesive_contact.postprocess import reaction_sides, reactions
 from adhesive_contact.storage import json_number
 
 

@@ -11,7 +11,7 @@ from test_cli import assert_one_line_error
 from test_cli import run as run_cli
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict
-from adhesive_contact.admissibility import on_wall
+from adhesive_contact.verification.admissibility import on_wall
 
 #: the wall case (b) of studies/convergence, small: u*_ν = g for x ≤ 0.5
 BASE = {

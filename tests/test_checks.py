@@ -10,9 +10,9 @@ import pytest
 from conftest import scene_dict
 
 from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
-from adhesive_contact.convergence import with_discretisation
+from adhesive_contact.verification.levels import with_discretisation
 from adhesive_contact.scheme import STEP_FAILED, InvalidState
-from adhesive_contact.scheme.checks import check_level
+from adhesive_contact.scheme.level_checks import check_level
 from adhesive_contact.scheme.operators import StepOperators
 from adhesive_contact.scheme.state import (
     ContactStep,

@@ -8,7 +8,7 @@ import pytest
 import scipy.sparse as sp
 
 from adhesive_contact import build_problem, scene_from_dict
-from adhesive_contact.contact_energy import HessianMap
+from adhesive_contact.scheme.contact_energy import HessianMap
 from adhesive_contact.scheme.state import ContactStep
 
 NORMAL = {"law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01}

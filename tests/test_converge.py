@@ -17,7 +17,7 @@ from skfem.helpers import ddot, sym_grad
 
 import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, parse_scene
-from adhesive_contact.convergence import default_reference_refinement, run_reference
+from adhesive_contact.verification.levels import default_reference_refinement, run_reference
 
 # no contact: u* is smooth and the library derives body force and tractions;
 # 8 steps keep the time error below the space error of the 3 levels

@@ -202,7 +202,7 @@ def test_numpy_and_sympy_forms_of_each_function_agree(name):
     # differentiate the sympy one, the time loop evaluates the NumPy one
     import sympy
 
-    from adhesive_contact.manufactured import to_sympy
+    from adhesive_contact.verification.manufactured import to_sympy
     x = np.linspace(0.05, 0.95, 13)
     expr = compile_expression(_call(name))
     symbol = sympy.Symbol("x")

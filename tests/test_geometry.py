@@ -23,11 +23,11 @@ from adhesive_contact import (
     scene_from_dict,
     solve,
 )
-from adhesive_contact.contact_boundary import facet_normals
-from adhesive_contact.meshes import build_mesh, read_mesh_file
-from adhesive_contact.meshes.builtin import structured_mesh
+from adhesive_contact.fem.contact_boundary import facet_normals
+from adhesive_contact.fem.meshes import build_mesh, read_mesh_file
+from adhesive_contact.fem.meshes.builtin import structured_mesh
 from adhesive_contact.scene import MeshSpec
-from adhesive_contact.verification import prolongation
+from adhesive_contact.verification.errors import prolongation
 
 MESHES = Path(__file__).resolve().parents[1] / "studies" / "meshes"
 HALF_DISC = MESHES / "half_disc.msh"
@@ -305,7 +305,7 @@ def test_a_body_inside_the_foundation_is_refused():
 def test_fine_contact_facets_find_their_coarse_facet(path, dim):
     """Two refinements: each fine facet's centroid lies in its parent facet
     (barycentric coordinates in [0, 1] and on its plane)."""
-    from adhesive_contact.verification import facet_parents, nested_meshes
+    from adhesive_contact.verification.errors import facet_parents, nested_meshes
     if path is None:
         spec = MeshSpec("box", (1.0, 0.5, 0.5), (2, 1, 1), dim=3)
         side = "bottom"
@@ -335,7 +335,7 @@ def test_builtin_sides_and_facets_equal_scikit_fems_own(spec):
     over to the named copy, are those scikit-fem finds and builds itself."""
     from skfem import MeshTet, MeshTri
 
-    from adhesive_contact.meshes.builtin import SIDES, side_tests
+    from adhesive_contact.fem.meshes.builtin import SIDES, side_tests
 
     mesh = structured_mesh(spec)
     fresh = (MeshTri if mesh.dim() == 2 else MeshTet)(mesh.p, mesh.t)

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import cg, spsolve
 from skfem import MeshTet, MeshTri
 
-from adhesive_contact.assembly import Assembly, stiffness_basis
+from adhesive_contact.fem.assembly import Assembly, stiffness_basis
 from adhesive_contact.linear_solvers import (
     METHODS,
     AMGSolver,
@@ -29,7 +29,7 @@ from adhesive_contact.linear_solvers import (
     pardiso,
     rigid_body_modes,
 )
-from adhesive_contact.meshes import side_tests
+from adhesive_contact.fem.meshes import side_tests
 
 LAM, MU = 576.9230769230769, 384.6153846153846   # E = 1000, ν = 0.3
 EPS = np.finfo(float).eps

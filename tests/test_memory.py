@@ -10,7 +10,7 @@ from conftest import prony, relative_max, run, scene_dict
 from scipy.integrate import quad
 
 from adhesive_contact import compile_expression
-from adhesive_contact.memory import FunctionMemory, PronyMemory
+from adhesive_contact.scheme.memory import FunctionMemory, PronyMemory
 
 # --------------------------------------------------------------------------
 # The history sums

@@ -7,8 +7,9 @@ import pytest
 from conftest import scene_dict
 from skfem import Basis, MeshTet, MeshTri, asm
 
-from adhesive_contact import build_problem, p1, scene_from_dict
-from adhesive_contact.assembly import (
+from adhesive_contact import build_problem, scene_from_dict
+from adhesive_contact.fem import p1
+from adhesive_contact.fem.assembly import (
     LoadMap,
     divergence_product,
     quadrature_load_map,

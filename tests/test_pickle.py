@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from adhesive_contact import build_problem, parse_scene, solve
-from adhesive_contact.convergence import with_discretisation
+from adhesive_contact.verification.levels import with_discretisation
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = {

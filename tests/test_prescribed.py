@@ -6,7 +6,7 @@ import pytest
 from conftest import DELETE, prony, scene_dict
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
-from adhesive_contact.reactions import prescribed_history, reaction_sides, reactions
+from adhesive_contact.postprocess import prescribed_history, reaction_sides, reactions
 
 L, H = 2.0, 0.5
 E, NU = 1000.0, 0.3
@@ -236,7 +236,7 @@ def test_relaxation_test_follows_the_modulus():
 def test_reactions_contact_and_loads_balance():
     # Σ_sides R + Σ_a F_a + ∫ f_N = 0 with memory, contact and a traction
     from adhesive_contact.postprocess import total_contact_force
-    from adhesive_contact.reactions import applied_traction
+    from adhesive_contact.postprocess import applied_traction
 
     data = scene_dict({"boundary.dirichlet": ["left"], "mesh.cells": [8, 2],
                        "boundary.displacement": {"top": ["free", "-0.001*t*x"]},
@@ -267,7 +267,7 @@ def test_cli_refuses_a_body_free_to_move_with_exit_2(tmp_path):
 
 
 def test_large_displacements_and_far_stiffness_are_warned():
-    from adhesive_contact.sanity import magnitude_warnings
+    from adhesive_contact.problem.warnings import magnitude_warnings
 
     # the right end moved by 0.4 (0.402 with the contraction) on a body of size 2.06
     data = scene_dict({"boundary.displacement.right": ["0.4*t", "free"]}, STRETCH)

@@ -22,11 +22,11 @@ from adhesive_contact import (
     SceneError,
     build_problem,
     compile_expression,
-    manufactured,
     resources,
     scene_from_dict,
     solve,
 )
+from adhesive_contact.verification import manufactured
 
 BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
                     "contact.normal": law("compliance", c=100.0), "time.steps": 2})

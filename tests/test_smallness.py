@@ -9,7 +9,7 @@ import pytest
 from conftest import law, scene_dict
 
 from adhesive_contact import scene_from_dict
-from adhesive_contact import smallness as module
+from adhesive_contact.problem import smallness as module
 from adhesive_contact.laws import make_friction, make_normal_law
 
 SCENE = scene_dict({"mesh.cells": [4, 1], "mesh.size": [2.0, 0.5],

@@ -18,7 +18,7 @@ from test_cli import strict_json
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.scheme import STEP_FAILED
-from adhesive_contact.scheme.checks import check_level, wall_record
+from adhesive_contact.scheme.level_checks import check_level, wall_record
 from adhesive_contact.step_methods import (
     MAX_ITERATIONS,
     METHODS,

@@ -75,7 +75,7 @@ def read_arrays(path, names):
 
 def rebuild_problem(path, document):
     """The problem of the scene text that summary.json (at ``path``) keeps."""
-    from ..problem import build_problem
+    from ..problem.build import build_problem
     from ..scene import SceneError, parse_scene
 
     source = document.get("source")

@@ -23,7 +23,7 @@ import zipfile
 
 import numpy as np
 
-from ..reactions import reaction_sides, reactions
+from ..postprocess.reactions import reaction_sides, reactions
 from .xdmf import contact_facets
 
 

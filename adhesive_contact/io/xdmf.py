@@ -16,7 +16,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from ..postprocess import contact_fields, stress_3x3, von_mises
+from ..postprocess.quantities import contact_fields, stress_3x3, von_mises
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 REOPEN = 100   # levels between reopenings of the HDF5 file

@@ -11,7 +11,7 @@
 - :mod:`.solution`: what a run returns, :class:`Solution`.
 """
 
-from .checks import InvalidState
+from .level_checks import InvalidState
 from .loop import solve
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
 

@@ -9,7 +9,7 @@ rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
 
 import time
 
-from .checks import check_level, check_load
+from .level_checks import check_level, check_load
 from .operators import StepOperators
 from .recorder import HistoryRecorder
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure

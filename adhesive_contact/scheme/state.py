@@ -12,8 +12,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..bonding import FacetRate, advance
-from ..contact_energy import ContactEnergy
+from .bonding import FacetRate, advance
+from .contact_energy import ContactEnergy
 from ..expressions import coordinates
 from ..step_methods import MAX_ITERATIONS, Kink, StepOptions, minimise
 

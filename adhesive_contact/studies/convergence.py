@@ -33,7 +33,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..convergence import (
+from ..verification.levels import (
     PARAMS,
     Reference,
     default_reference_refinement,
@@ -44,7 +44,7 @@ from ..convergence import (
     run_reference,
     with_discretisation,
 )
-from ..meshes import build_mesh
+from ..fem.meshes import build_mesh
 from ..scene import scene_from_dict
 from ..storage import write_atomic, write_json
 from .pool import attempt

@@ -39,7 +39,7 @@ import tomllib
 from dataclasses import dataclass
 
 from .. import SceneError, build_problem, scene_from_dict, solve
-from ..postprocess import beta_mean, contact_states
+from ..postprocess.quantities import beta_mean, contact_states
 from ..storage import plain, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 

@@ -47,8 +47,8 @@ def build(dim, cells, path):
     """Assemble the clamped stiffness and save (A, points, free) to path."""
     from skfem import MeshTet, MeshTri
 
-    from adhesive_contact.assembly import Assembly, stiffness_basis
-    from adhesive_contact.meshes import side_tests
+    from adhesive_contact.fem.assembly import Assembly, stiffness_basis
+    from adhesive_contact.fem.meshes import side_tests
 
     axes = [np.linspace(0.0, 1.0, cells + 1)] * dim
     mesh = (MeshTri if dim == 2 else MeshTet).init_tensor(*axes).with_boundaries(

@@ -59,7 +59,7 @@ GRID_STEPS = (4, 8, 16, 32, 64, 128)
 def variant(base, *, linear="superlu", quadrature="nodal", refine=0, steps=4, amg_tol=None):
     """The base scene with a backend (and AMG's tolerance), a quadrature, a
     refinement and steps."""
-    from adhesive_contact.convergence import with_discretisation
+    from adhesive_contact.verification.levels import with_discretisation
 
     solver = replace(base.solver, linear=linear)
     if amg_tol is not None:
@@ -72,7 +72,7 @@ def variant(base, *, linear="superlu", quadrature="nodal", refine=0, steps=4, am
 def measure(scene):
     """One run (level 0 of an h-study of ``scene``): its record, timed by
     the fastest of 3 when it takes under REPEAT_BELOW seconds, else of 2."""
-    from adhesive_contact.convergence import run_level
+    from adhesive_contact.verification.levels import run_level
 
     try:
         record = run_level(scene, "h", 0)

@@ -27,7 +27,7 @@ from skfem import (
 from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
 
-from .expressions import coordinates
+from ..expressions import coordinates
 from .p1 import CellLoad, gradients, stiffness_parts, strain_operator, symmetric_pairs
 
 

@@ -26,10 +26,10 @@ the condition, the point and the time.
 
 import numpy as np
 
-from .contact_boundary import facet_normals, facet_points, tangent_frame
-from .expressions import coordinates
+from ..fem.contact_boundary import facet_normals, facet_points, tangent_frame
+from ..expressions import coordinates
 from .manufactured import TOLERANCE, on_wall
-from .scene import SceneError
+from ..scene import SceneError
 
 
 #: relative tolerance of the checks, and of the contact and stick sets

@@ -21,12 +21,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .assembly import stiffness_basis, strain_map
-from .contact_boundary import facet_normals
-from .meshes import mesh_size
-from .problem import build_problem
-from .scheme import solve
-from .verification import (
+from ..fem.assembly import stiffness_basis, strain_map
+from ..fem.contact_boundary import facet_normals
+from ..fem.meshes import mesh_size
+from ..problem.build import build_problem
+from ..scheme import solve
+from .errors import (
     ExactErrors,
     facet_parents,
     fitted_rate,

@@ -25,7 +25,7 @@ from functools import partial
 
 import numpy as np
 
-from .expressions import FUNCTIONS, VARIABLES, Expression, chain
+from ..expressions import FUNCTIONS, VARIABLES, Expression, chain
 
 #: relative tolerance of "u*_ν = g" (the contact set of a manufactured solution)
 TOLERANCE = 1e-10

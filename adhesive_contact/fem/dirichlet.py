@@ -24,9 +24,9 @@ rigid motion free (the step matrix would be singular without contact).
 import numpy as np
 import scipy.sparse as sp
 
-from .expressions import compile_expression, coordinates
+from ..expressions import compile_expression, coordinates
 from .meshes import named_facets
-from .scene import SceneError
+from ..scene import SceneError
 
 _ZERO = compile_expression("0")
 

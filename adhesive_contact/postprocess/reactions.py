@@ -57,7 +57,7 @@ def prescribed_history(solution, side):
 
 def side_mean_displacement(solution, side):
     """The mean nodal displacement of a side per level (M+1, d)."""
-    from .meshes import named_facets
+    from ..fem.meshes import named_facets
 
     mesh = solution.problem.mesh
     nodes = np.unique(mesh.facets[:, named_facets(mesh, [side], "side", indexed=False)])
@@ -69,8 +69,8 @@ def applied_traction(problem, side, times):
     ``times`` (len(times), d), by a Gauss rule of order 4 on its facets."""
     from skfem import ElementTetP1, ElementTriP1, FacetBasis
 
-    from .expressions import coordinates
-    from .meshes import named_facets
+    from ..expressions import coordinates
+    from ..fem.meshes import named_facets
 
     mesh, d = problem.mesh, problem.dim
     facets = named_facets(mesh, [side], "loads.traction", indexed=False)

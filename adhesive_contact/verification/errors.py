@@ -26,10 +26,10 @@ import scipy.sparse as sp
 from skfem import Basis
 from skfem.quadrature import get_quadrature
 
-from .assembly import vector_element
-from .contact_boundary import facet_points
-from .expressions import coordinates
-from .meshes import build_mesh, refinement_parents
+from ..fem.assembly import vector_element
+from ..fem.contact_boundary import facet_points
+from ..expressions import coordinates
+from ..fem.meshes import build_mesh, refinement_parents
 
 
 def _one_level(coarse, fine):

@@ -40,8 +40,8 @@ from scipy.sparse.linalg import eigsh, splu
 from skfem import BilinearForm, FacetBasis, asm
 from skfem.helpers import dot
 
-from .assembly import Assembly, vector_element
-from .meshes import build_mesh
+from ..fem.assembly import Assembly, vector_element
+from ..fem.meshes import build_mesh
 
 
 @BilinearForm

@@ -16,8 +16,8 @@ calls them, since the points come from the geometry.
 
 import numpy as np
 
-from .expressions import coordinates
-from .scene import SceneError
+from ..expressions import coordinates
+from ..scene import SceneError
 
 #: time levels sampled besides t = 0 and t = T
 TIME_SAMPLES = 16

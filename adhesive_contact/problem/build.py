@@ -15,24 +15,24 @@ from dataclasses import dataclass, field
 import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1, FacetBasis
 
-from .admissibility import check_manufactured
-from .assembly import LOAD_INTORDER, Assembly, LoadMap, is_zero, vector_element, vector_of
-from .contact_boundary import (
+from ..verification.admissibility import check_manufactured
+from ..fem.assembly import LOAD_INTORDER, Assembly, LoadMap, is_zero, vector_element, vector_of
+from ..fem.contact_boundary import (
     build_contact_boundary,
     facet_normals,
     facet_points,
     tangent_frame,
 )
-from .dirichlet import prescribed_displacement
-from .expressions import coordinates
-from .foundation import foundation_gap
-from .laws import make_bonding, make_friction, make_normal_law
-from .manufactured import ManufacturedSolution
-from .memory import make_memory
-from .meshes import build_mesh, named_facets
-from .scene import SceneError
+from ..fem.dirichlet import prescribed_displacement
+from ..expressions import coordinates
+from ..fem.foundation import foundation_gap
+from ..laws import make_bonding, make_friction, make_normal_law
+from ..verification.manufactured import ManufacturedSolution
+from ..scheme.memory import make_memory
+from ..fem.meshes import build_mesh, named_facets
+from ..scene import SceneError
 from .smallness import smallness
-from .value_checks import check_exact, check_kernel, check_loads
+from .checks import check_exact, check_kernel, check_loads
 
 
 @dataclass(kw_only=True)

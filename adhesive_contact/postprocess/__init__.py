@@ -1,0 +1,19 @@
+"""Quantities derived from a solution: stresses, contact tractions and
+forces, β means (:mod:`.quantities`), the contact state of every node
+(:mod:`.states`), the reactions of the held sides (:mod:`.reactions`).
+Their figures are :mod:`adhesive_contact.visuals`."""
+
+from .quantities import (FRAMES, beta_mean, cell_von_mises, contact_fields,
+                         contact_nodal_forces, contact_traction, normal_traction, stress_3x3,
+                         tangential_traction, to_global, total_contact_force, von_mises)
+from .reactions import (applied_traction, prescribed_history, reaction_sides, reactions,
+                        side_mean_displacement, side_reactions)
+from .quantities import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STICK, WALL,
+                         contact_state_code, contact_state_codes, contact_states)
+
+__all__ = ["FRAMES", "beta_mean", "cell_von_mises", "contact_fields", "contact_nodal_forces",
+           "contact_traction", "normal_traction", "stress_3x3", "tangential_traction",
+           "to_global", "total_contact_force", "von_mises", "applied_traction",
+           "prescribed_history", "reaction_sides", "reactions", "side_mean_displacement",
+           "side_reactions", "COMPLIANCE", "SEPARATED", "SLIP", "STATE_NAMES", "STICK", "WALL",
+           "contact_state_code", "contact_state_codes", "contact_states"]
