@@ -151,8 +151,8 @@ def solve_command(scene, out, force, quiet):
     """
     from adhesive_contact import solve
     from adhesive_contact.io import StreamingRecorder
-    from adhesive_contact.postprocess import beta_mean
-    from adhesive_contact.problem.warnings import magnitude_warnings
+    from adhesive_contact.postprocess import beta_mean, contact_state_counts
+    from adhesive_contact.problem.warnings import solution_warnings
     from adhesive_contact.scheme import STOPPED
 
     from .output import staged_output, write_results
@@ -180,7 +180,7 @@ def solve_command(scene, out, force, quiet):
                                      progress=lambda n, N: bar.update(1, recorder.last)
                                      or interrupted())
                 if solution.t.size:   # the levels that converged, partial or not
-                    for warning in magnitude_warnings(solution):
+                    for warning in solution_warnings(solution):
                         if not quiet:
                             click.echo(f"warning: {warning}", err=True)
                     files = write_results(solution, folder, failures, source)
@@ -211,7 +211,7 @@ def solve_command(scene, out, force, quiet):
                f"{int(solution.iterations.sum())} solver iterations, "
                f"{solution.timings['total']:.2f} s")
     if boundary is not None and boundary.facets.size:
-        states = {key: int(value[-1]) for key, value in solution.contact_states().items()}
+        states = {key: int(value[-1]) for key, value in contact_state_counts(solution).items()}
         friction = (f", stick {states['stick']}, slip {states['slip']}"
                     if "stick" in states else "")
         click.echo(f"  Γ_C at t = {parsed.T:g}: β mean {beta_mean(solution)[-1]:.4g}, "

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from adhesive_contact.io import write_npz, write_xdmf
 from adhesive_contact.resources import estimate
-from adhesive_contact.problem.warnings import magnitude_warnings
+from adhesive_contact.problem.warnings import solution_warnings
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 
@@ -63,7 +63,7 @@ def summary(solution, source=None):
         },
         "run": run_record(solution),
         "smallness": smallness_record(problem),
-        "warnings": [str(w) for w in problem.warnings()] + magnitude_warnings(solution),
+        "warnings": [str(w) for w in problem.warnings()] + solution_warnings(solution),
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
         "resources": resources_record(solution),

@@ -5,7 +5,7 @@ this module only formats them.
 
 import numpy as np
 
-from adhesive_contact.postprocess import beta_mean, total_contact_force
+from adhesive_contact.postprocess import beta_mean, contact_state_counts, total_contact_force
 from adhesive_contact.postprocess import reaction_sides, reactions
 from adhesive_contact.storage import json_number
 
@@ -34,14 +34,14 @@ def step_records(solution):
     """The per-level entries of ``summary.json``'s ``steps`` list.
 
     Each is ``{"t", "probes", "normal_force", "tangential_force", "beta_mean",
-    "beta_min", "n_wall", "separated", "on_wall", "stick", "slip",
+    "beta_min", "separated", "on_wall", "stick", "slip",
     "max_penetration", "iterations", "residual"}``: normal_force is the total
     force of Γ_C on the body, positive in compression; tangential_force its
     tangential part in the nodal frames, a number in 2D and a list of d − 1
     in 3D; beta_mean (weighted by the facet measures) and beta_min are None
     without contact facets; separated, on_wall, stick and slip count contact
-    nodes (:meth:`~adhesive_contact.Solution.contact_states`; stick and slip
-    are None without friction; n_wall = on_wall, kept for older readers);
+    nodes (:func:`~adhesive_contact.postprocess.contact_state_counts`; stick
+    and slip are None without friction);
     max_penetration is max_a (u_ν − g), None without a wall; ``reactions``
     is {side: [F_x, F_y(, F_z)]}, the force each held side's support exerts
     on the body (:mod:`adhesive_contact.reactions`), and ``contact_force``
@@ -53,7 +53,7 @@ def step_records(solution):
     tangential = solution.total_tangential_force()
     means = beta_mean(solution)
     violation = solution.gap_violation()
-    states = solution.contact_states()
+    states = contact_state_counts(solution)
     sides = reaction_sides(solution.problem)
     held = reactions(solution)
     boundary = solution.problem.boundary
@@ -70,7 +70,6 @@ def step_records(solution):
                                  else _vector(tangential[n])),
             "beta_mean": None if means is None else json_number(means[n]),
             "beta_min": json_number(solution.beta[n].min()) if has_beta else None,
-            "n_wall": int(solution.on_wall[n].sum()),
             "separated": _count(states["separated"], n),
             "on_wall": _count(states["on_wall"], n),
             "stick": _count(states.get("stick"), n),

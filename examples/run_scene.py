@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from adhesive_contact import build_problem, load_scene, solve
-from adhesive_contact.postprocess import beta_mean, total_contact_force
+from adhesive_contact.postprocess import beta_mean, contact_state_counts, total_contact_force
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -30,7 +30,7 @@ def main(steps=20):
     mean = beta_mean(solution)                   # (M+1,), facet-measure weighted
     normal = solution.total_normal_force()       # (M+1,), compression > 0
     force = total_contact_force(solution)        # (M+1, d), global components
-    states = solution.contact_states()           # counts per level
+    states = contact_state_counts(solution)      # counts per level
     print(f"{'t':>5} {'beta mean':>9} {'beta min':>9} {'normal F':>9} {'F_x':>9} separated")
     for n, t in enumerate(solution.t):
         print(f"{t:5.2f} {mean[n]:9.4f} {solution.beta[n].min():9.4f} {normal[n]:9.3f} "

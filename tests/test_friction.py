@@ -37,8 +37,9 @@ from scipy.optimize import minimize
 from scipy.sparse.linalg import spsolve
 
 from adhesive_contact import StepFailure, build_problem, scene_from_dict, solve
+from adhesive_contact.postprocess import contact_state_counts
 from adhesive_contact.scheme import STEP_FAILED, STOPPED
-from adhesive_contact.step_solver import MAX_ITERATIONS
+from adhesive_contact.step_methods import MAX_ITERATIONS
 
 E, NU, C = 1000.0, 0.3, 1.0e4
 SIZE, CELLS = (2.0, 0.5), (16, 4)
@@ -502,7 +503,7 @@ def test_slip_weakening_newton_iterations_bounded():
     assert np.all(its >= 1) and np.all(its <= 30)
     assert np.all(sol.residual[1:] <= problem.scene.solver.tol)
     # the last step slips somewhere and sticks somewhere
-    states = sol.contact_states()
+    states = contact_state_counts(sol)
     assert states["stick"][-1] > 0 and states["slip"][-1] > 0
 
 

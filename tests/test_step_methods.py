@@ -18,7 +18,7 @@ from test_cli import strict_json
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.scheme import STEP_FAILED
-from adhesive_contact.scheme.level_checks import check_level, wall_record
+from adhesive_contact.scheme.level_checks import WALL_SLACK, check_level
 from adhesive_contact.step_methods import (
     MAX_ITERATIONS,
     METHODS,
@@ -26,7 +26,7 @@ from adhesive_contact.step_methods import (
     StepOptions,
     minimise,
 )
-from adhesive_contact.step_solver import minimise_step
+from adhesive_contact.step_methods.newton import minimise_step
 
 TRESCA = law("tresca", mu=5.0)
 WEAKENING = law("nonmonotone", a=8.0, b=4.0, alpha=50.0)
@@ -88,15 +88,14 @@ def test_penalty_violation_falls_as_one_over_the_penalty():
         violation.append(sol.gap_violation().max())
         distance.append(relative(sol.u, ref.u))
         # the wall check of the exact methods does not apply to it
-        assert violation[-1] > 0 and wall_record(sol)["max_violation"] == violation[-1]
-        assert not wall_record(sol)["exact"]
+        assert violation[-1] > 0
     violation, distance = np.array(violation), np.array(distance)
     # ρ (u_ν − g) ≈ λ, fixed by the solution: ×10 in ρ is ÷10 in the
     # violation (measured 9.94–9.99) and in the distance to the exact run
     np.testing.assert_allclose(violation[:-1] / violation[1:], 10.0, rtol=0.02)
     np.testing.assert_allclose(distance[:-1] / distance[1:], 10.0, rtol=0.02)
-    assert wall_record(ref) == {"method": "newton", "exact": True, "max_violation": 0.0,
-                                "max_relative_violation": 0.0}
+    # the exact method stays on the wall's side to round-off (scheme.level_checks.WALL_SLACK)
+    assert ref.gap_violation().max() <= WALL_SLACK * (1.0 + np.abs(ref.normal_displacement).max())
 
 
 def test_the_wall_check_still_applies_to_the_exact_methods():

@@ -18,29 +18,15 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import (
     Basis,
-    BilinearForm,
     ElementTetP1,
     ElementTriP1,
     ElementVector,
     FacetBasis,
 )
-from skfem.helpers import ddot, div, sym_grad
 from skfem.quadrature import get_quadrature
 
 from ..expressions import coordinates
 from .p1 import CellLoad, gradients, stiffness_parts, strain_operator, symmetric_pairs
-
-
-@BilinearForm
-def divergence_product(u, v, w):
-    """∫ div u div v: the λ part of the isotropic stiffness."""
-    return div(u) * div(v)
-
-
-@BilinearForm
-def strain_product(u, v, w):
-    """∫ 2 ε(u) : ε(v): the μ part of the isotropic stiffness."""
-    return 2.0 * ddot(sym_grad(u), sym_grad(v))
 
 
 def vector_element(dim):

@@ -17,8 +17,8 @@ reactions add up to the total. A contact node with a held component
 leaves Γ_C (the prescription wins, as for a clamped node): its free
 components are then ordinary unknowns without contact terms.
 
-:func:`check_rigid_motions` refuses a scene whose held components leave a
-rigid motion free (the step matrix would be singular without contact).
+:func:`rigid_modes` gives the rigid motions whose restriction to the held
+dofs :func:`adhesive_contact.problem.checks.check_rigid_motions` reads.
 """
 
 import numpy as np
@@ -26,7 +26,6 @@ import scipy.sparse as sp
 
 from ..expressions import compile_expression, coordinates
 from .meshes import named_facets
-from ..scene import SceneError
 
 _ZERO = compile_expression("0")
 
@@ -43,7 +42,8 @@ class PrescribedDisplacement:
     dim : int
     """
 
-    def __init__(self, fixed, sides, dim, groups, shares, side_dofs=None):
+    def __init__(self, fixed, sides, dim, groups, shares, side_dofs=None, entries=(),
+                 count=None):
         self.fixed = fixed
         self.sides = sides
         self.dim = dim
@@ -51,6 +51,10 @@ class PrescribedDisplacement:
         # (positions within fixed, expression, coordinates (d, m)) of the nonzero data
         self._groups = groups
         self._shares = shares.tocsr()   # (nsides·d, nD): reaction share of each side
+        # (side index, component, dofs, expression, key) of every held component, and
+        # how many sides hold each dof of ``fixed``: what the checks of the scene read
+        self.entries = tuple(entries)
+        self.count = np.zeros(fixed.size) if count is None else count
 
     @property
     def is_zero(self):
@@ -77,13 +81,10 @@ class PrescribedDisplacement:
 
 
 def prescribed_displacement(scene, mesh):
-    """The :class:`PrescribedDisplacement` of a scene on ``mesh``.
-
-    Raises SceneError when two sides hold one dof at different values (at
-    some t_n) or when the held components leave a rigid motion free."""
+    """The :class:`PrescribedDisplacement` of a scene on ``mesh`` (checked by
+    :func:`adhesive_contact.problem.checks.check_prescribed`)."""
     d = mesh.dim()
     sides = scene.held_sides
-    times = scene.k * np.arange(scene.steps + 1)
     rows = []   # (side index, component, dofs, expression, key)
     for s, side in enumerate(sides):
         if side in scene.dirichlet:
@@ -115,56 +116,10 @@ def prescribed_displacement(scene, mesh):
                                shape=(len(sides) * d, fixed.size))
     else:
         shares = sp.coo_matrix((0, 0))
-    _check_agreement(rows, fixed, count, mesh, times)
-    if scene.exact is not None:
-        _check_exact(rows, scene, mesh, times)
-    check_rigid_motions(mesh, fixed, sides)
     side_dofs = {side: {} for side in sides}
     for s, c, dofs, expr, key in rows:
         side_dofs[sides[s]][c] = dofs
-    return PrescribedDisplacement(fixed, sides, d, groups, shares, side_dofs)
-
-
-def _check_agreement(rows, fixed, count, mesh, times):
-    """Every dof held by several sides gets one value from all of them."""
-    shared = count > 1
-    if not shared.any():
-        return
-    d = mesh.dim()
-    first = {}
-    for s, c, dofs, expr, key in rows:
-        pos = np.searchsorted(fixed, dofs)
-        keep = shared[pos]
-        if not keep.any():
-            continue
-        x = mesh.p[:, dofs[keep] // d]
-        values = np.array([np.broadcast_to(expr(*coordinates(x), t=t), x.shape[1])
-                           for t in times])
-        for p, column in zip(pos[keep], values.T):
-            if p not in first:
-                first[p] = (column, key)
-                continue
-            other, other_key = first[p]
-            if np.abs(column - other).max() > 1e-12 * (1.0 + np.abs(other).max()):
-                where = ", ".join(f"{v:g}" for v in mesh.p[:, fixed[p] // d])
-                raise SceneError(key, f"holds the node ({where}) at another value than "
-                                 f"{other_key}; sides that share a node must prescribe "
-                                 "the same value there (or leave it \"free\" on one)")
-
-
-def _check_exact(rows, scene, mesh, times):
-    """In a scene with [exact], a held component must equal u* on its side."""
-    d = mesh.dim()
-    for s, c, dofs, expr, key in rows:
-        if scene.held_sides[s] in scene.dirichlet:
-            continue
-        x = mesh.p[:, dofs // d]
-        for t in times:
-            given = np.broadcast_to(expr(*coordinates(x), t=t), x.shape[1])
-            exact = np.broadcast_to(scene.exact.u[c](*coordinates(x), t=t), x.shape[1])
-            if np.abs(given - exact).max() > 1e-10 * (1.0 + np.abs(exact).max()):
-                raise SceneError(key, f"must equal exact.u[{c}] on the side in a scene "
-                                 f"with [exact] (differs at t = {t:g})")
+    return PrescribedDisplacement(fixed, sides, d, groups, shares, side_dofs, rows, count)
 
 
 def rigid_modes(points):
@@ -187,31 +142,3 @@ def rigid_modes(points):
     return np.stack(modes, axis=1)
 
 
-_MOTIONS = {2: ("translation along x", "translation along y", "rotation"),
-            3: ("translation along x", "translation along y", "translation along z",
-                "rotation about x", "rotation about y", "rotation about z")}
-
-
-def check_rigid_motions(mesh, fixed, sides):
-    """Refuse held dofs ``fixed`` that leave a rigid motion of the body free:
-    the rank of the rigid modes restricted to them must be 3 in 2D (two
-    translations and the rotation) and 6 in 3D."""
-    d = mesh.dim()
-    modes = rigid_modes(mesh.p)
-    held = modes[fixed]
-    nmodes = modes.shape[1]
-    if fixed.size:
-        _, sv, vt = np.linalg.svd(held, full_matrices=True)
-        rank = int((sv > 1e-8 * sv[0]).sum()) if sv.size else 0
-    else:
-        rank, vt = 0, np.eye(nmodes)
-    if rank == nmodes:
-        return
-    free_modes = vt[rank:]                 # the rigid motions the held dofs leave
-    names = [name for k, name in enumerate(_MOTIONS[d])
-             if np.abs(free_modes[:, k]).max() > 1e-6]
-    raise SceneError("boundary", "the held sides (" + (", ".join(sides) or "none") + ") leave "
-                     "the body free to move rigidly (" + ", ".join(names) + "): hold more "
-                     "components, e.g. list a side in boundary.dirichlet or give \"0\" for "
-                     "the missing component on a side of [boundary.displacement] (a single "
-                     "held point does not stop a rotation: hold a component along a side)")

@@ -17,6 +17,8 @@ nodal force over the lumped nodal weight w_a = ∫_{Γ_C} φ_a
 
 import numpy as np
 
+from .states import contact_state_code
+
 FRAMES = ("nodal", "global")
 
 
@@ -160,71 +162,6 @@ def beta_mean(solution):
     if boundary is None or boundary.facets.size == 0:
         return None
     return solution.beta @ boundary.measure / boundary.measure.sum()
-
-
-def contact_states(solution):
-    """The state of every contact node at every level, as boolean masks.
-
-    - ``separated``: u_ν < 0 (away from the foundation);
-    - ``on_wall``: u_ν = g, held by the rigid wall;
-    - ``compliance``: u_ν ≥ 0 and not on the wall (in the compliant layer);
-    - with a friction law, ``stick``: touching (u_ν ≥ 0) and held at ξ = 0
-      by a friction kink; ``slip``: touching, not stuck, with u_τ ≠ 0.
-
-    Returns
-    -------
-    dict of str to ndarray of bool, each (N+1, nc). Their sums over the
-    nodes are :meth:`Solution.contact_states`.
-    """
-    un = solution.frame_displacement[:, :, 0]
-    separated = un < 0
-    touching = ~separated
-    out = {"separated": separated, "on_wall": solution.on_wall.copy(),
-           "compliance": touching & ~solution.on_wall}
-    if solution.problem.friction is not None:
-        moving = np.linalg.norm(solution.frame_displacement[:, :, 1:], axis=2) > 0
-        out["stick"] = touching & solution.stuck
-        out["slip"] = touching & ~solution.stuck & moving
-    return out
-
-
-#: the integer codes of :func:`contact_state_code`
-SEPARATED, COMPLIANCE, WALL, STICK, SLIP = 0, 1, 2, 3, 4
-STATE_NAMES = ("separated", "compliance", "wall", "stick", "slip")
-
-
-def contact_state_code(problem, frame_displacement, on_wall, stuck):
-    """One integer state per contact node, of one level or of several.
-
-    0 separated (u_ν < 0); for a touching node (u_ν ≥ 0), with a friction
-    law, 3 stick (held at ξ = 0 by a friction kink) or 4 slip (u_τ ≠ 0,
-    not stuck); otherwise 2 wall (u_ν = g) or 1 compliance. A node that
-    sticks or slips may also be on the wall (``on_wall`` says so).
-
-    Parameters
-    ----------
-    problem : Problem
-    frame_displacement : (..., nc, d) nodal-frame displacements
-    on_wall, stuck : (..., nc) bool
-
-    Returns
-    -------
-    ndarray of int8, (..., nc)
-    """
-    frame_displacement = np.asarray(frame_displacement)
-    touching = frame_displacement[..., 0] >= 0
-    code = np.where(np.asarray(on_wall), WALL, COMPLIANCE)
-    if problem.friction is not None:
-        moving = np.linalg.norm(frame_displacement[..., 1:], axis=-1) > 0
-        code = np.where(moving, SLIP, code)
-        code = np.where(np.asarray(stuck), STICK, code)
-    return np.where(touching, code, SEPARATED).astype(np.int8)
-
-
-def contact_state_codes(solution):
-    """:func:`contact_state_code` at every level (N+1, nc)."""
-    return contact_state_code(solution.problem, solution.frame_displacement,
-                              solution.on_wall, solution.stuck)
 
 
 def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):

@@ -34,13 +34,6 @@ def reactions(solution):
     return side_reactions(solution.problem, solution.reaction)
 
 
-def reactions_by_side(solution, n):
-    """{side: [F_x, F_y(, F_z)]} at level n (plain floats, for JSON)."""
-    values = side_reactions(solution.problem, solution.reaction[n])
-    return {side: [float(v) for v in values[i]]
-            for i, side in enumerate(reaction_sides(solution.problem))}
-
-
 def prescribed_history(solution, side):
     """The mean prescribed displacement of ``side`` per level (M+1, d):
     the mean of g_D over the side's held dofs for each held component, NaN

@@ -7,6 +7,7 @@ every warning about a scene or a run, :mod:`.smallness` the estimate of the
 theory's smallness conditions.
 """
 
-from .build import Problem, build_problem
+from .build import build_problem
+from .problem import Problem
 
 __all__ = ["Problem", "build_problem"]

@@ -1,21 +1,33 @@
-"""A scene made discrete: everything built once before the time loop.
+"""A scene made discrete: :func:`build_problem`, a pipeline of named stages.
 
-:func:`build_problem` turns a :class:`~adhesive_contact.scene.Scene` into
-a :class:`Problem`: the mesh and its per-mesh operators, the free dofs,
-Γ_C (only if the scene has contact terms), the load map, the gap at the
-contact nodes for every t_n, the initial bonding β_0^h = P_B β_0, the laws
-and the probes. A Problem is never changed by a run: each run starts its
-own memory history (:meth:`Problem.start_memory`). Checks that need the geometry (a probe outside
-the mesh, a negative gap) raise :class:`~adhesive_contact.scene.SceneError`.
+Each stage reads the scene and what the stages before it built, checks
+what it can check once the geometry is known (:mod:`.checks`: each raises
+:class:`~adhesive_contact.scene.SceneError` naming the key) and returns
+its part of the :class:`~.problem.Problem`:
+
+1. :func:`mesh_and_dofs`: the mesh and its per-mesh operators;
+2. :func:`held_dofs`: the prescribed displacements, the free dofs;
+3. :func:`contact_laws`: the normal law, the friction and the bonding law;
+4. :func:`manufactured_solution`: for a scene with [exact], its derived data;
+5. :func:`contact`: Γ_C (only if the scene has contact terms), the step's
+   unknowns and the gap at the contact nodes for every t_n;
+6. :func:`initial_bonding`: β_0^h = P_B β_0 (and the source s_β of a
+   manufactured solution);
+7. :func:`loads`: the load map of f_0 and f_N (or of a manufactured
+   solution's loads);
+8. :func:`probes`: the probe map.
+
+A Problem is never changed by a run: each run starts its own memory
+history (:meth:`~.problem.Problem.start_memory`).
 """
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from skfem import Basis, ElementTetP1, ElementTriP1, FacetBasis
 
-from ..verification.admissibility import check_manufactured
+from ..expressions import coordinates
 from ..fem.assembly import LOAD_INTORDER, Assembly, LoadMap, is_zero, vector_element, vector_of
 from ..fem.contact_boundary import (
     build_contact_boundary,
@@ -24,101 +36,202 @@ from ..fem.contact_boundary import (
     tangent_frame,
 )
 from ..fem.dirichlet import prescribed_displacement
-from ..expressions import coordinates
 from ..fem.foundation import foundation_gap
-from ..laws import make_bonding, make_friction, make_normal_law
-from ..verification.manufactured import ManufacturedSolution
-from ..scheme.memory import make_memory
 from ..fem.meshes import build_mesh, named_facets
+from ..laws import make_bonding, make_friction, make_normal_law
 from ..scene import SceneError
-from .smallness import smallness
-from .checks import check_exact, check_kernel, check_loads
+from ..verification.admissibility import check_manufactured
+from ..verification.manufactured import ManufacturedSolution
+from .checks import (
+    check_beta0,
+    check_exact,
+    check_gap,
+    check_kernel,
+    check_loads,
+    check_outside_foundation,
+    check_prescribed,
+    check_probes,
+)
+from .problem import Problem
 
 
-@dataclass(kw_only=True)
-class Problem:
-    """A discretised scene; built once, never changed by a run.
+def build_problem(scene):
+    """Discretise a scene: the stages of the module docstring, in order."""
+    t0 = time.perf_counter()
+    times = scene.k * np.arange(scene.steps + 1)
+    mesh, assembly = mesh_and_dofs(scene)
+    held = held_dofs(scene, mesh, assembly)
+    if scene.memory is not None and scene.memory.kernel == "function":
+        check_kernel("memory.r", scene.memory.function, scene.k, scene.steps)
+    laws = contact_laws(scene)
+    exact = manufactured_solution(scene, mesh, laws, times, held)
+    on_contact = contact(scene, mesh, assembly, held, laws, times)
+    beta0, beta_source = initial_bonding(scene, mesh, on_contact.boundary, exact)
+    probe_map = probes(scene, mesh)
+    return Problem(scene=scene, mesh=mesh, assembly=assembly, free=held.free,
+                   prescribed=held.prescribed, boundary=on_contact.boundary,
+                   columns=on_contact.columns, contact_positions=on_contact.positions,
+                   loads=loads(scene, mesh, exact, held, times), gap=on_contact.gap,
+                   beta0=beta0, normal_law=laws.normal, friction=laws.friction,
+                   bonding=laws.bonding, probe_map=probe_map, times=times,
+                   assembly_seconds=time.perf_counter() - t0, exact=exact,
+                   beta_source=beta_source)
 
-    Absent concepts are None (``boundary``, ``gap``, ``friction``,
-    ``bonding``, ``probe_map``, ``exact``, ``beta_source``), except the
-    normal law, whose null object :class:`~adhesive_contact.laws.NoNormalLaw`
-    contributes nothing, and the memory (:class:`~adhesive_contact.memory.NoMemory`)."""
 
-    scene: object
-    mesh: object
-    assembly: Assembly
-    free: np.ndarray          # free dofs (not held by a side)
-    prescribed: object        # PrescribedDisplacement: the held dofs and g_D(t)
+# ---------------------------------------------------------------- 1. mesh and dofs
+
+
+def mesh_and_dofs(scene):
+    """The mesh with its named sides, and the operators assembled once on it."""
+    mesh = build_mesh(scene.mesh)
+    return mesh, Assembly(mesh)
+
+
+# ---------------------------------------------------------------- 2. held dofs
+
+
+@dataclass(frozen=True)
+class HeldDofs:
+    """The prescribed displacements and what they leave free."""
+
+    prescribed: object        # PrescribedDisplacement
+    free: np.ndarray          # the free dofs
+    position: np.ndarray      # (ndofs,) position of a dof within ``free``, −1 if held
+    clamped_nodes: np.ndarray  # nodes with a held component
+    dirichlet_facets: np.ndarray
+    contact_facets: np.ndarray
+
+
+def held_dofs(scene, mesh, assembly):
+    """The held dofs of ``[boundary]`` (checked: consistent, no rigid motion
+    left free) and the free dofs, numbered."""
+    d = mesh.dim()
+    dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
+    contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
+    prescribed = prescribed_displacement(scene, mesh)
+    check_prescribed(prescribed, scene, mesh)
+    # a node with any held component leaves Γ_C (module adhesive_contact.fem.dirichlet)
+    clamped_nodes = np.unique(prescribed.fixed // d)
+    held = np.zeros(assembly.ndofs, dtype=bool)
+    held[prescribed.fixed] = True
+    free = np.flatnonzero(~held)
+    position = np.full(assembly.ndofs, -1)
+    position[free] = np.arange(free.size)
+    return HeldDofs(prescribed, free, position, clamped_nodes, dirichlet_facets,
+                    contact_facets)
+
+
+# ---------------------------------------------------------------- 3. laws
+
+
+@dataclass(frozen=True)
+class ContactLaws:
+    """The laws of ``[contact]``, made once."""
+
+    normal: object            # a normal law (NoNormalLaw when none)
+    friction: object          # FrictionSum or None
+    bonding: object           # a bonding law or None (β frozen)
+
+
+def contact_laws(scene):
+    """The law objects of the scene's ``[contact]`` tables."""
+    return ContactLaws(make_normal_law(scene.contact.normal),
+                       make_friction(scene.contact.friction),
+                       make_bonding(scene.contact.bonding))
+
+
+# ---------------------------------------------------------------- 4. manufactured solution
+
+
+def manufactured_solution(scene, mesh, laws, times, held):
+    """The :class:`~adhesive_contact.verification.manufactured.ManufacturedSolution`
+    of a scene with [exact] (None without), its u*, β*, λ* checked finite
+    and admissible."""
+    if scene.exact is None:
+        return None
+    check_exact(scene.exact, mesh.p, times)
+    try:
+        exact = ManufacturedSolution(scene, laws.normal, laws.friction, laws.bonding)
+    except (ArithmeticError, ValueError, TypeError, KeyError) as err:
+        raise SceneError("exact", "the loads cannot be derived from the exact solution "
+                         f"({type(err).__name__}: {err})") from None
+    check_manufactured(scene, mesh, exact, times, scene.contact.gap, held.dirichlet_facets,
+                       held.contact_facets)
+    return exact
+
+
+# ---------------------------------------------------------------- 5. contact
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Γ_C and the step's unknowns on it (empty without contact terms)."""
+
     boundary: object          # ContactBoundary, or None
     columns: np.ndarray       # the step's unknowns among the nc·d frame components
-    contact_positions: np.ndarray  # positions of those unknowns within ``free``
-    loads: LoadMap
+    positions: np.ndarray     # positions of those unknowns within ``free``
     gap: np.ndarray           # (N+1, nc) g(x_a, t_n), or None for no wall
-    beta0: np.ndarray         # (nf,) β_0^h
-    normal_law: object
-    friction: object          # FrictionSum or None
-    bonding: object           # bonding law or None (β frozen)
-    probe_map: object         # sparse (nprobes, npoints) or None
-    times: np.ndarray         # t_n, n = 0..N
-    assembly_seconds: float
-    exact: object = None      # ManufacturedSolution, for scenes with [exact]
-    beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
-    _smallness: dict = field(default=None, repr=False)
 
-    def start_memory(self):
-        """A fresh memory history for one run (the rectangle rule's state)."""
-        return make_memory(self.scene.memory)
 
-    @property
-    def smallness(self):
-        """The terms of docs/model.md §3's condition (None without contact),
-        computed on first use (a generalised eigenproblem) and kept."""
-        if self._smallness is None and self.boundary is not None:
-            self._smallness = smallness(self.scene, self.normal_law, self.friction)
-        return self._smallness
+def contact(scene, mesh, assembly, held, laws, times):
+    """Γ_C with its frames and quadrature, the step's unknowns on it and
+    the gap; nothing without contact terms."""
+    d = mesh.dim()
+    empty = np.zeros(0, dtype=np.int64)
+    if not scene.has_contact_terms:
+        return Contact(None, empty, empty, None)
+    boundary = build_contact_boundary(mesh, held.contact_facets, held.clamped_nodes,
+                                      scene.contact.quadrature, scene.contact.order)
+    assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
+    # without friction only u_ν enters the contact terms (the traces of
+    # the tangential components vanish on flat facets): solve for it alone
+    tangential = boundary.unknowns(np.arange(1, d))
+    normal_only = laws.friction is None and (
+        tangential.size == 0
+        or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
+    columns = boundary.unknowns([0] if normal_only else np.arange(d))
+    positions = held.position[boundary.dofs.ravel()[columns]]
+    gap = gap_at_nodes(scene, mesh, boundary, times) if scene.contact.has_wall else None
+    return Contact(boundary, columns, positions, gap)
 
-    def warnings(self):
-        """What the theory does not cover for this scene, one line each."""
-        out = []
-        s = self.smallness
-        if s is not None and not s["holds"]:
-            tail = ("each step still has one solution (its energy is convex)"
-                    if s["step_energy_convex"] else
-                    "a step may have several solutions and the solver may pick any or fail")
-            out.append(f"the smallness condition of the error estimate does not hold "
-                       f"(m_A = {s['m_A']:.4g} against (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}): "
-                       f"the theory does not promise a unique solution or first-order "
-                       f"convergence here, and {tail}; softer contact laws or a stiffer "
-                       f"body move the scene inside it "
-                       f"(docs/model.md#the-three-smallness-conditions)")
-        if (self.bonding is not None and self.scene.contact.integrator == "explicit"
-                and self.scene.k > self.bonding.stable_step()):
-            out.append(f"the time step k = {self.scene.k:.4g} exceeds the explicit Euler bound "
-                       f"1/((gamma_nu + gamma_tau) L^2) = {self.bonding.stable_step():.4g} of "
-                       f"the bonding law, so beta may leave [0, 1] and the run stop: use more "
-                       f"steps or another contact.bonding.integrator "
-                       f"(docs/conventions.md#the-explicit-euler-bound-on-the-time-step)")
-        return out
 
-    @property
-    def dim(self):
-        return self.mesh.dim()
+def gap_at_nodes(scene, mesh, boundary, times):
+    """g(x_a, t_n) (N+1, nc) at the contact nodes: the scene's gap
+    expression, or the distance to the foundation along the nodal normal
+    ν_a (:mod:`~adhesive_contact.fem.foundation`; +∞ where the normal misses it)."""
+    x = mesh.p[:, boundary.nodes]
+    if scene.contact.foundation is not None:
+        g, depth = foundation_gap(scene.contact.foundation, x, boundary.frame[:, :, 0].T)
+        check_outside_foundation(x, depth)
+        return np.broadcast_to(g, (times.size, g.size)).copy()
+    gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
+    check_gap(gap, x, times)
+    return gap
 
-    @property
-    def ndofs(self):
-        return self.assembly.ndofs
 
-    @property
-    def normal_columns(self):
-        """Positions within the step's unknowns of the normal components."""
-        return np.flatnonzero(self.columns % self.dim == 0)
+# ---------------------------------------------------------------- 6. initial bonding
 
-    def upper_bound(self, n):
-        """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
-        upper = np.full(self.columns.size, np.inf)
-        if self.gap is not None:
-            upper[self.normal_columns] = self.gap[n]
-        return upper
+
+def initial_bonding(scene, mesh, boundary, exact):
+    """β_0^h = P_B β_0 on the contact facets (nf,), and the bonding source
+    s_β at the quadrature points of Γ_C of a manufactured solution (else
+    None). β_0 is β* at t = 0 with [exact], else ``contact.bonding.beta0``
+    (default 1)."""
+    if boundary is None:
+        return np.zeros(0), None
+    if exact is not None:
+        normals = _side_normals_at(mesh, boundary)
+        frames = tangent_frame(normals)                     # (nq, d, d)
+        beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
+        return _facet_mean(mesh, boundary, exact.beta), beta_source
+    beta0 = scene.contact.beta0
+    if beta0 is None:
+        return np.ones(boundary.facets.size), None
+    if beta0.is_constant:
+        return np.full(boundary.facets.size, float(beta0(0.0))), None
+    values = _facet_mean(mesh, boundary, beta0)
+    check_beta0(values)
+    return values, None
 
 
 def _facet_mean(mesh, boundary, expr, order=4):
@@ -128,147 +241,64 @@ def _facet_mean(mesh, boundary, expr, order=4):
     return values @ weights
 
 
-def build_problem(scene):
-    """Discretise a scene (see module docstring)."""
-    t0 = time.perf_counter()
-    mesh = build_mesh(scene.mesh)
-    assembly = Assembly(mesh)
-    d = mesh.dim()
+def _side_normals_at(mesh, boundary):
+    """Outward facet normals (d, nq) at the quadrature points of Γ_C."""
+    normals, _ = facet_normals(mesh, boundary.facets)
+    return normals[:, boundary.facet_of_point]
 
-    dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
-    contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
-    prescribed = prescribed_displacement(scene, mesh)
-    # a node with any held component leaves Γ_C (module adhesive_contact.dirichlet)
-    clamped_nodes = np.unique(prescribed.fixed // d)
-    held = np.zeros(assembly.ndofs, dtype=bool)
-    held[prescribed.fixed] = True
-    free = np.flatnonzero(~held)
-    position = np.full(assembly.ndofs, -1)
-    position[free] = np.arange(free.size)
 
-    times = scene.k * np.arange(scene.steps + 1)
-    if scene.memory is not None and scene.memory.kernel == "function":
-        check_kernel("memory.r", scene.memory.function, scene.k, scene.steps)
-    friction = make_friction(scene.contact.friction)
-    boundary, gap, beta0 = None, None, np.zeros(0)
-    columns = contact_positions = np.zeros(0, dtype=np.int64)
-    if scene.has_contact_terms:
-        boundary = build_contact_boundary(mesh, contact_facets, clamped_nodes,
-                                          scene.contact.quadrature, scene.contact.order)
-        assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
-        # without friction only u_ν enters the contact terms (the traces of
-        # the tangential components vanish on flat facets): solve for it alone
-        tangential = boundary.unknowns(np.arange(1, d))
-        normal_only = friction is None and (
-            tangential.size == 0
-            or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
-        columns = boundary.unknowns([0] if normal_only else np.arange(d))
-        contact_positions = position[boundary.dofs.ravel()[columns]]
-        if scene.contact.has_wall:
-            gap = _gap(scene, mesh, boundary, times)
-        beta0 = np.ones(boundary.facets.size)
-        if scene.contact.beta0 is not None and scene.contact.beta0.is_constant:
-            beta0 = np.full(boundary.facets.size, float(scene.contact.beta0(0.0)))
-        elif scene.contact.beta0 is not None:
-            beta0 = _facet_mean(mesh, boundary, scene.contact.beta0)
-            if not np.all((beta0 >= 0) & (beta0 <= 1)):
-                raise SceneError("contact.bonding.beta0", "must lie in [0, 1] on Γ_C")
+# ---------------------------------------------------------------- 7. loads
 
-    probe_map = None
-    if scene.probes:
-        scalar = Basis(mesh, ElementTriP1() if d == 2 else ElementTetP1())
-        points = np.array(scene.probes, dtype=float).T
-        for i in range(points.shape[1]):
-            try:
-                scalar.probes(points[:, i:i + 1])
-            except ValueError:
-                raise SceneError(f"output.probes[{i}]", "point "
-                                 f"({', '.join(f'{c:g}' for c in points[:, i])}) "
-                                 "is outside the mesh") from None
-        probe_map = scalar.probes(points).tocsr()
 
-    normal_law = make_normal_law(scene.contact.normal)
-    bonding = make_bonding(scene.contact.bonding)
-    exact = beta_source = None
-    if scene.exact is None:
+def loads(scene, mesh, exact, held, times):
+    """The :class:`~adhesive_contact.fem.assembly.LoadMap` of the body force
+    and the surface tractions, checked finite where it is evaluated: the
+    scene's ``[loads]``, or a manufactured solution's f_0, f_N on the
+    remaining sides and f_C on Γ_C."""
+    if exact is None:
         body = None if is_zero(scene.body) else vector_of(scene.body)
-        surface = [(named_facets(mesh, [side], "loads.traction", indexed=False), vector_of(exprs))
-                   for side, exprs in scene.traction.items()]
-        checks = ([] if body is None else
-                  [[(f"loads.body[{i}]", e) for i, e in enumerate(scene.body)]])
-        checks += [[(f"loads.traction.{side}[{i}]", e) for i, e in enumerate(exprs)]
-                   for side, exprs in scene.traction.items()]
+        surface = [(named_facets(mesh, [side], "loads.traction", indexed=False),
+                    vector_of(exprs)) for side, exprs in scene.traction.items()]
+        keyed = ([] if body is None else
+                 [[(f"loads.body[{i}]", e) for i, e in enumerate(scene.body)]])
+        keyed += [[(f"loads.traction.{side}[{i}]", e) for i, e in enumerate(exprs)]
+                  for side, exprs in scene.traction.items()]
+        load_map = LoadMap(mesh, body, surface)
     else:
-        check_exact(scene.exact, mesh.p, times)
-        try:
-            exact = ManufacturedSolution(scene, normal_law, friction, bonding)
-        except (ArithmeticError, ValueError, TypeError, KeyError) as err:
-            raise SceneError("exact", "the loads cannot be derived from the exact solution "
-                             f"({type(err).__name__}: {err})") from None
-        check_manufactured(scene, mesh, exact, times, scene.contact.gap, dirichlet_facets,
-                           contact_facets)
-        body = exact.body_force
         neumann = np.setdiff1d(mesh.boundary_facets(),
-                               np.concatenate([dirichlet_facets, contact_facets]))
+                               np.concatenate([held.dirichlet_facets, held.contact_facets]))
         surface = []
         if neumann.size:
             surface.append((neumann, exact.traction(_load_point_normals(mesh, neumann))))
-        if contact_facets.size:
-            normal = _load_point_normals(mesh, contact_facets)           # (d, npoints)
+        if held.contact_facets.size:
+            normal = _load_point_normals(mesh, held.contact_facets)      # (d, npoints)
             tangents = tangent_frame(normal)[:, :, 1:].transpose(2, 1, 0)  # (d-1, d, npoints)
-            surface.append((contact_facets, exact.contact_load(normal, tangents)))
-        if boundary is not None:
-            normals = _side_normals_at(mesh, boundary)
-            frames = tangent_frame(normals)                     # (nq, d, d)
-            beta_source = exact.beta_source(normals, frames[:, :, 1:].transpose(2, 1, 0))
-            beta0 = _facet_mean(mesh, boundary, exact.beta)
-    loads = LoadMap(mesh, body, surface)
-    if scene.exact is not None:
-        checks = [[("exact", field)] for field, _ in loads.parts]
-    check_loads(checks, loads, times)
-    return Problem(scene=scene, mesh=mesh, assembly=assembly, free=free,
-                   prescribed=prescribed, boundary=boundary,
-                   columns=columns, contact_positions=contact_positions, loads=loads, gap=gap,
-                   beta0=beta0, normal_law=normal_law, friction=friction, bonding=bonding,
-                   probe_map=probe_map, times=times,
-                   assembly_seconds=time.perf_counter() - t0, exact=exact,
-                   beta_source=beta_source)
-
-
-def _gap(scene, mesh, boundary, times):
-    """g(x_a, t_n) (N+1, nc) at the contact nodes: the scene's gap
-    expression, or the distance to the foundation along the nodal normal
-    ν_a (:mod:`~adhesive_contact.foundation`; +∞ where the normal misses it)."""
-    x = mesh.p[:, boundary.nodes]
-    if scene.contact.foundation is not None:
-        g, depth = foundation_gap(scene.contact.foundation, x, boundary.frame[:, :, 0].T)
-        inside = depth < -1e-12 * (1.0 + np.abs(x).max())
-        if inside.any():
-            a = int(np.argmax(inside))
-            raise SceneError("contact.foundation", "the contact node "
-                             f"({', '.join(f'{c:g}' for c in x[:, a])}) lies inside the "
-                             "foundation; the body must start outside it")
-        return np.broadcast_to(g, (times.size, g.size)).copy()
-    gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
-    bad = ~(np.isfinite(gap) & (gap >= 0))
-    if bad.any():
-        n, a = np.argwhere(bad)[0]
-        where = ", ".join(f"{c:g}" for c in x[:, a])
-        raise SceneError("contact.gap", f"must be finite and >= 0 on Γ_C, got "
-                         f"{gap[n, a]:g} at ({where}), t = {times[n]:g}")
-    return gap
+            surface.append((held.contact_facets, exact.contact_load(normal, tangents)))
+        load_map = LoadMap(mesh, exact.body_force, surface)
+        keyed = [[("exact", field)] for field, _ in load_map.parts]
+    check_loads(keyed, load_map, times)
+    return load_map
 
 
 def _load_point_normals(mesh, facets):
     """Outward unit normals (d, npoints) of the facets at the points where
-    :class:`~adhesive_contact.assembly.LoadMap` evaluates a surface load
+    :class:`~adhesive_contact.fem.assembly.LoadMap` evaluates a surface load
     (each facet's own normal: the sides may be curved or slanted)."""
     basis = FacetBasis(mesh, vector_element(mesh.dim()), facets=facets,
                        intorder=LOAD_INTORDER)
     return np.asarray(basis.normals).reshape(mesh.dim(), -1)
 
 
-def _side_normals_at(mesh, boundary):
-    """Outward facet normals (d, nq) at the quadrature points of Γ_C."""
-    normals, _ = facet_normals(mesh, boundary.facets)
-    return normals[:, boundary.facet_of_point]
+# ---------------------------------------------------------------- 8. probes
+
+
+def probes(scene, mesh):
+    """The sparse map (nprobes, npoints) from nodal values to the probe
+    points of ``[output] probes`` (None without probes), each checked to
+    lie in the mesh."""
+    if not scene.probes:
+        return None
+    scalar = Basis(mesh, ElementTriP1() if mesh.dim() == 2 else ElementTetP1())
+    points = np.array(scene.probes, dtype=float).T
+    check_probes(scalar, points)
+    return scalar.probes(points).tocsr()

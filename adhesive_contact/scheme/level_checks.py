@@ -14,7 +14,7 @@ and after each level that
   the size of g and u_ν): the exact step methods project onto the wall.
   Not for ``solver.method = "penalty"``, which solves a nearby problem
   and leaves a violation by design; it is recorded
-  (:meth:`~.solution.Solution.gap_violation`, :func:`wall_record`) instead.
+  (:meth:`~.solution.Solution.gap_violation`) instead.
 
 A violation stops the run with :class:`InvalidState`, one paragraph that
 says what failed, where, the figures and what to try.
@@ -22,6 +22,7 @@ says what failed, where, the figures and what to try.
 
 import numpy as np
 
+from ..problem.checks import where
 from ..step_methods import EXACT
 from .solution import StepFailure
 
@@ -42,9 +43,9 @@ class InvalidState(StepFailure):
         return (type(self), (self.n, self.t, self.reason, self.result))
 
 
-def _where(problem, facet):
-    x = problem.mesh.p[:, problem.boundary.facet_nodes[:, facet]].mean(axis=1)
-    return "(" + ", ".join(f"{c:.4g}" for c in x) + ")"
+def _facet_midpoint(problem, facet):
+    return where(problem.mesh.p[:, problem.boundary.facet_nodes[:, facet]].mean(axis=1),
+                 digits=4)
 
 
 def check_load(n, t, b):
@@ -67,7 +68,7 @@ def check_level(problem, level):
     if beta.size and problem.beta_source is None and (beta.min() < -BETA_SLACK or beta.max() > 1 + BETA_SLACK):
         facet = int(np.argmin(beta) if beta.min() < -BETA_SLACK else np.argmax(beta))
         reason = (f"beta = {beta[facet]:.4g} leaves [0, 1] on the contact facet at "
-                  f"{_where(problem, facet)}")
+                  f"{_facet_midpoint(problem, facet)}")
         bonding = problem.bonding
         if bonding is not None and problem.scene.contact.integrator == "explicit":
             k, bound = problem.scene.k, bonding.stable_step()
@@ -91,22 +92,5 @@ def check_level(problem, level):
             x = problem.mesh.p[:, problem.boundary.nodes[worst]]
             return InvalidState(n, t, (
                 f"u_nu - g = {excess[worst]:.3g} > 0 at the contact node "
-                f"({', '.join(f'{c:.4g}' for c in x)}): the rigid wall is crossed"))
+                f"{where(x, digits=4)}: the rigid wall is crossed"))
     return None
-
-
-def wall_record(solution):
-    """How far a run crossed the wall: ``{"method", "exact", "max_violation",
-    "max_relative_violation"}``, the largest u_ν − g over the levels (0 when
-    never crossed, None without a wall), and relative to max |u_ν|. The
-    exact step methods leave round-off; "penalty" leaves about λ/ρ."""
-    method = solution.problem.scene.solver.method
-    out = {"method": method, "exact": method in EXACT, "max_violation": None,
-           "max_relative_violation": None}
-    violation = solution.gap_violation()
-    if solution.problem.gap is None or not np.all(np.isfinite(violation)):
-        return out
-    worst = max(float(violation.max(initial=0.0)), 0.0)
-    size = float(np.abs(solution.normal_displacement).max(initial=0.0))
-    out.update(max_violation=worst, max_relative_violation=worst / size if size > 0 else 0.0)
-    return out

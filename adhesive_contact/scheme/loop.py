@@ -1,8 +1,9 @@
 """The time loop of the fully discrete scheme (Problem 4.1).
 
 u_0 solves the problem at t = 0 with the elastic stiffness alone (no memory
-yet). For n = 1..N, with k = T/N and t_n = n k: the explicit Euler step
-(4.2) gives β_n from level n − 1; u_n minimises the step energy with the
+yet). For n = 1..N, with k = T/N and t_n = n k: the bonding step (4.2),
+by the scene's integrator (:mod:`.bonding`: explicit Euler as in the paper,
+implicit or exponential), gives β_n from level n − 1; u_n minimises the step energy with the
 step matrix A + k R(0), the load f(t_n) minus the memory history (right
 rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
 """

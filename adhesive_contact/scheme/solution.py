@@ -72,19 +72,6 @@ class Solution:
         """u_ν at the contact nodes (M+1, nc)."""
         return self.frame_displacement[:, :, 0]
 
-    def contact_states(self):
-        """Counts per level of contact nodes that are separated (u_ν < 0),
-        on the wall, stuck (ξ = 0 held by friction) and slipping (the rest
-        in contact with friction): a dict of (M+1,) int arrays."""
-        separated = self.normal_displacement < 0
-        touching = ~separated
-        out = {"separated": separated.sum(axis=1), "on_wall": self.on_wall.sum(axis=1)}
-        if self.problem.friction is not None:
-            moving = np.linalg.norm(self.frame_displacement[:, :, 1:], axis=2) > 0
-            out["stick"] = (touching & self.stuck).sum(axis=1)
-            out["slip"] = (touching & ~self.stuck & moving).sum(axis=1)
-        return out
-
     def total_normal_force(self):
         """Σ_a of the normal force Γ_C exerts, positive in compression (M+1,)."""
         return -self.contact_force[:, :, 0].sum(axis=1)

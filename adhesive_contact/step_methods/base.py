@@ -116,6 +116,15 @@ class Stationarity:
         return self.residual / self.scale
 
 
+def kink_subgradient(h, kappa):
+    """The element of least norm of h + B(0, κ_a) at nodes with ξ_a = 0,
+    h_a (1 − κ_a/|h_a|)₊: zero where |h_a| ≤ κ_a (the node sticks), else
+    the force that the kink cannot hold. ``h`` (na, m), ``kappa`` (na,)."""
+    hn = np.linalg.norm(h, axis=1)
+    slide = np.where(hn > kappa, 1.0 - kappa / np.where(hn > 0, hn, 1.0), 0.0)
+    return h * slide[:, None]
+
+
 def stationarity(S, c, energy, upper, z, kink):
     """The pseudo-gradient of E at z: the minimal-norm element of
     ∂E(z) + N_wall(z), with ∂E the Clarke subdifferential (kinks: the ball
@@ -134,8 +143,7 @@ def stationarity(S, c, energy, upper, z, kink):
     wall = np.isfinite(upper) & (z >= upper) & (g < 0)
     pg[wall] = 0.0
     if tan.size:
-        slide = np.where(hn > kappa, 1.0 - kappa / np.where(hn > 0, hn, 1.0), 0.0)
-        pg[tan[at_zero]] = (h * slide[:, None])[at_zero]
+        pg[tan[at_zero]] = kink_subgradient(h, kappa)[at_zero]
     scale = max(np.abs(c).max(initial=0.0), np.abs(Sz).max(initial=0.0),
                 np.abs(gphi).max(initial=0.0), kappa.max(initial=0.0), 1e-300)
     return Stationarity(g=g, Sz=Sz, xi=xi, s=s, at_zero=at_zero, unit=unit, h=h, hn=hn, pg=pg,

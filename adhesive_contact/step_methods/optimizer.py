@@ -27,6 +27,7 @@ from .base import (
     OPTIMIZER_ITERATIONS,
     OPTIMIZER_STOPPED,
     StepResult,
+    kink_subgradient,
     no_kink,
     stationarity,
 )
@@ -46,11 +47,7 @@ def minimise(S, c, energy, upper, z0, options, kink=None):
             xi = z[tan]
             zero = ~np.any(xi != 0, axis=1)
             if zero.any():
-                h = g[tan[zero]]
-                hn = np.linalg.norm(h, axis=1)
-                slide = np.where(hn > kink.radius[zero],
-                                 1.0 - kink.radius[zero] / np.where(hn > 0, hn, 1.0), 0.0)
-                g[tan[zero]] = h * slide[:, None]
+                g[tan[zero]] = kink_subgradient(g[tan[zero]], kink.radius[zero])
         return E, g
 
     bounds = [(None, None if not np.isfinite(b) else float(b)) for b in upper]

@@ -33,12 +33,11 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..verification.rates import pairwise_rates, rates
 from ..verification.levels import (
     PARAMS,
     Reference,
     default_reference_refinement,
-    pairwise_rates,
-    rates,
     reference_scene,
     run_level,
     run_reference,

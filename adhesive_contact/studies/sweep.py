@@ -39,7 +39,8 @@ import tomllib
 from dataclasses import dataclass
 
 from .. import SceneError, build_problem, scene_from_dict, solve
-from ..postprocess.quantities import beta_mean, contact_states
+from ..postprocess.quantities import beta_mean
+from ..postprocess.states import contact_state_counts
 from ..storage import plain, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 
@@ -237,7 +238,7 @@ def run_variant(document, values):
             "failure": {"step": failure.n, "t": failure.t, "residual": result.residual,
                         "iterations": result.nit, "message": str(failure)},
             "residual": result.residual})
-    states = {key: mask[-1].sum() for key, mask in contact_states(solution).items()}
+    states = {key: counts[-1] for key, counts in contact_state_counts(solution).items()}
     has_beta = solution.beta.shape[1] > 0
     return plain(record | {
         "outcome": "ok", "failure": None,

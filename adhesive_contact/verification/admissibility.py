@@ -29,14 +29,11 @@ import numpy as np
 from ..fem.contact_boundary import facet_normals, facet_points, tangent_frame
 from ..expressions import coordinates
 from .manufactured import TOLERANCE, on_wall
+from ..problem.checks import where
 from ..scene import SceneError
 
 
 #: relative tolerance of the checks, and of the contact and stick sets
-def _where(x, i, t):
-    return "(" + ", ".join(f"{c:.4g}" for c in x[:, i]) + f"), t = {t:g}"
-
-
 def _points(mesh, facets):
     """Vertices and Gauss points (d, n) of a set of boundary facets."""
     nodes = mesh.facets[:, facets]
@@ -85,7 +82,7 @@ def check_manufactured(scene, mesh, exact, times, gap, clamped_facets, contact_f
             raise SceneError("exact.u", f"must vanish on the clamped sides "
                              f"({', '.join(scene.dirichlet)}); u* = "
                              f"({', '.join(f'{v:.3g}' for v in u[:, worst])}) at "
-                             f"{_where(clamped, worst, t)}")
+                             f"{where(clamped, worst, t, digits=4)}")
     friction = exact.friction
     for x, normal, tangent in contact.values():
         for t in times:
@@ -95,14 +92,14 @@ def check_manufactured(scene, mesh, exact, times, gap, clamped_facets, contact_f
             if beta.min() < -TOLERANCE or beta.max() > 1 + TOLERANCE:
                 i = int(np.argmin(beta) if beta.min() < -TOLERANCE else np.argmax(beta))
                 raise SceneError("exact.beta", f"must lie in [0, 1] on Γ_C; β* = "
-                                 f"{beta[i]:.4g} at {_where(x, i, t)}")
+                                 f"{beta[i]:.4g} at {where(x, i, t, digits=4)}")
             if gap is not None:
                 g = gap(*coordinates(x), t=t) * np.ones(r.shape)
                 excess = r - g
                 i = int(np.argmax(excess))
                 if excess[i] > TOLERANCE * (size + abs(g[i])):
                     raise SceneError("exact.u", f"must satisfy u*_nu <= g on Γ_C; u*_nu - g = "
-                                     f"{excess[i]:.3g} at {_where(x, i, t)}")
+                                     f"{excess[i]:.3g} at {where(x, i, t, digits=4)}")
                 touching = on_wall(r, g)
                 if touching.any() and exact.has_multiplier:
                     lam = exact.multiplier(*coordinates(x), t=t) * np.ones(r.shape)
@@ -110,7 +107,7 @@ def check_manufactured(scene, mesh, exact, times, gap, clamped_facets, contact_f
                     if bad.any():
                         i = int(np.flatnonzero(bad)[0])
                         raise SceneError("exact.multiplier", f"must be >= 0 where u*_nu = g; "
-                                         f"lambda* = {lam[i]:.4g} at {_where(x, i, t)}")
+                                         f"lambda* = {lam[i]:.4g} at {where(x, i, t, digits=4)}")
             if friction is not None and friction.has_kink:
                 xi = np.stack([np.sum(u * tt, axis=0) for tt in tangent], axis=-1)
                 s = np.linalg.norm(xi, axis=-1)
@@ -119,6 +116,6 @@ def check_manufactured(scene, mesh, exact, times, gap, clamped_facets, contact_f
                     i = int(np.flatnonzero(ambiguous)[0])
                     raise SceneError("exact.u", f"stick/slip is ambiguous on Γ_C: |u*_tau| = "
                                      f"{s[i]:.3g}, round-off rather than 0 or a slip, at "
-                                     f"{_where(x, i, t)}; the friction force there would "
+                                     f"{where(x, i, t, digits=4)}; the friction force there would "
                                      f"point where round-off says. Make u*_tau exactly 0 "
                                      f"in the stick zone (e.g. with where(...))")

@@ -1,4 +1,4 @@
-"""Errors of docs/verification.md, nested prolongation, and fitted rates.
+"""Errors of docs/verification.md and the nested prolongation they use.
 
 Errors are measured as in the estimates: e_u(t_n) = ‖ε(u(t_n) − u_n^h)‖_{L²(Ω)},
 e_β(t_n) = ‖β(t_n) − β_n^h‖_{L²(Γ_C)}, E_n = e_u + e_β, and each reported as
@@ -130,12 +130,3 @@ class ExactErrors:
             return 0.0
         diff = self.beta_of(*coordinates(self.facet_x), t=t) - beta_h[:, None]
         return float(np.sqrt(np.sum(self.facet_w * diff * diff)))
-
-
-def fitted_rate(sizes, errors):
-    """Least-squares slope of log(error) against log(size) (NaN if < 2 usable)."""
-    sizes, errors = np.asarray(sizes, float), np.asarray(errors, float)
-    ok = (sizes > 0) & (errors > 0) & np.isfinite(errors)
-    if ok.sum() < 2:
-        return float("nan")
-    return float(np.polyfit(np.log(sizes[ok]), np.log(errors[ok]), 1)[0])

@@ -3,7 +3,7 @@
 A study refines a scene level by level — ``"h"``: one uniform (nested)
 mesh refinement per level; ``"k"``: the step halved per level; ``"hk"``:
 both — and measures at each level the errors of
-:mod:`adhesive_contact.verification`, max over the level's time grid,
+:mod:`.errors`, max over the level's time grid,
 against
 
 - the scene's exact solution (``reference = "exact"``), or
@@ -12,7 +12,7 @@ against
   defaults refine only in what the study varies, so that the other error,
   common to all levels and the reference, cancels.
 
-Everything here is pure computation: the caller stores the level records
+Their rates are :mod:`.rates`. Everything here is pure computation: the caller stores the level records
 (and the reference) and decides what to recompute.
 """
 
@@ -29,7 +29,6 @@ from ..scheme import solve
 from .errors import (
     ExactErrors,
     facet_parents,
-    fitted_rate,
     nested_meshes,
     prolongation,
     strain_error_fine,
@@ -196,23 +195,3 @@ def run_level(scene, param, level, reference=None, progress=None):
         "stepping_seconds": solution.timings["stepping"],
         "newton_iterations": int(solution.iterations.sum()),
     }
-
-
-def rates(records, param):
-    """Least-squares rates {"u", "beta", "E"} against h (or k for a k-study)."""
-    size = "k" if param == "k" else "h"
-    sizes = [r[size] for r in records]
-    return {name: fitted_rate(sizes, [r[key] for r in records])
-            for name, key in (("u", "err_u"), ("beta", "err_beta"), ("E", "E"))}
-
-
-def pairwise_rates(records, param, key="E"):
-    """Rates between consecutive levels (the first is None)."""
-    size = "k" if param == "k" else "h"
-    out = [None]
-    for a, b in zip(records[:-1], records[1:]):
-        if a[key] > 0 and b[key] > 0:
-            out.append(float(np.log(a[key] / b[key]) / np.log(a[size] / b[size])))
-        else:
-            out.append(None)
-    return out

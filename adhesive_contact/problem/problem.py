@@ -1,0 +1,80 @@
+"""The discretised scene, :class:`Problem`: what a run reads, built once
+by :func:`~adhesive_contact.problem.build.build_problem` and never changed
+by a run."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..fem.assembly import Assembly, LoadMap
+from ..scheme.memory import make_memory
+from .smallness import smallness
+from .warnings import problem_warnings
+
+
+@dataclass(kw_only=True)
+class Problem:
+    """A discretised scene; built once, never changed by a run.
+
+    Absent concepts are None (``boundary``, ``gap``, ``friction``,
+    ``bonding``, ``probe_map``, ``exact``, ``beta_source``), except the
+    normal law, whose null object :class:`~adhesive_contact.laws.NoNormalLaw`
+    contributes nothing, and the memory (:class:`~adhesive_contact.scheme.memory.NoMemory`)."""
+
+    scene: object
+    mesh: object
+    assembly: Assembly
+    free: np.ndarray          # free dofs (not held by a side)
+    prescribed: object        # PrescribedDisplacement: the held dofs and g_D(t)
+    boundary: object          # ContactBoundary, or None
+    columns: np.ndarray       # the step's unknowns among the nc·d frame components
+    contact_positions: np.ndarray  # positions of those unknowns within ``free``
+    loads: LoadMap
+    gap: np.ndarray           # (N+1, nc) g(x_a, t_n), or None for no wall
+    beta0: np.ndarray         # (nf,) β_0^h
+    normal_law: object
+    friction: object          # FrictionSum or None
+    bonding: object           # bonding law or None (β frozen)
+    probe_map: object         # sparse (nprobes, npoints) or None
+    times: np.ndarray         # t_n, n = 0..N
+    assembly_seconds: float
+    exact: object = None      # ManufacturedSolution, for scenes with [exact]
+    beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
+    _smallness: dict = field(default=None, repr=False)
+
+    def start_memory(self):
+        """A fresh memory history for one run (the rectangle rule's state)."""
+        return make_memory(self.scene.memory)
+
+    @property
+    def smallness(self):
+        """The terms of docs/model.md §3's condition (None without contact),
+        computed on first use (a generalised eigenproblem) and kept."""
+        if self._smallness is None and self.boundary is not None:
+            self._smallness = smallness(self.scene, self.normal_law, self.friction)
+        return self._smallness
+
+    def warnings(self):
+        """What the theory does not cover for this scene, and magnitudes it
+        should not have, one line each (:func:`.warnings.problem_warnings`)."""
+        return problem_warnings(self)
+
+    @property
+    def dim(self):
+        return self.mesh.dim()
+
+    @property
+    def ndofs(self):
+        return self.assembly.ndofs
+
+    @property
+    def normal_columns(self):
+        """Positions within the step's unknowns of the normal components."""
+        return np.flatnonzero(self.columns % self.dim == 0)
+
+    def upper_bound(self, n):
+        """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
+        upper = np.full(self.columns.size, np.inf)
+        if self.gap is not None:
+            upper[self.normal_columns] = self.gap[n]
+        return upper
