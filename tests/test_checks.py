@@ -13,6 +13,7 @@ from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
 from adhesive_contact.verification.levels import with_discretisation
 from adhesive_contact.scheme import STEP_FAILED, InvalidState
 from adhesive_contact.scheme.level_checks import check_level
+from adhesive_contact.scheme.memory import start_memory
 from adhesive_contact.scheme.operators import StepOperators
 from adhesive_contact.scheme.state import (
     ContactStep,
@@ -32,7 +33,7 @@ def debonding(steps):
 
 def first_level(problem):
     """Level 0 of a run, computed step by step with the scheme's functions."""
-    memory = problem.start_memory()
+    memory = start_memory(problem)
     operators = StepOperators.build(problem, memory)
     state = initial_state(problem, memory)
     b, history = step_load(problem, operators, state, 0, 0.0)

@@ -14,6 +14,7 @@ import pytest
 from conftest import law, prony, scene_dict
 
 from adhesive_contact import build_problem, scene_from_dict, solve
+from adhesive_contact.scheme.memory import start_memory
 from adhesive_contact.scheme.operators import StepOperators, contraction
 
 # the strip of conftest.BLOCK pressed onto a wall, sheared, for 3 steps
@@ -30,7 +31,7 @@ STRONG = prony((30000.0, 0.3, 0.2))
 def test_initial_state_with_memory_equals_the_elastic_problem(friction, memory, proximal):
     changes = {**CHANGES, "contact.friction": friction} if friction else CHANGES
     problem = build_problem(scene_from_dict(scene_dict({**changes, "memory": memory})))
-    operators = StepOperators.build(problem, problem.start_memory())
+    operators = StepOperators.build(problem, start_memory(problem))
     assert (operators.shift is not None) == proximal
     assert (operators.initial is operators.step) == proximal
     with_memory = solve(problem)
@@ -57,7 +58,7 @@ def test_contraction_bounds_the_spectral_radius(dim):
         changes.update({"dim": 3, "mesh.domain": "box", "mesh.size": [2.0, 1.0, 1.0],
                         "mesh.cells": [4, 2, 2], "loads.body": ["0", "-400", "0"]})
     problem = build_problem(scene_from_dict(scene_dict(changes)))
-    memory = problem.start_memory()
+    memory = start_memory(problem)
     material, k = problem.scene.material, problem.scene.k
     elastic, shift = (material.lam, material.mu), memory.instantaneous(k)
     free = problem.free
@@ -79,7 +80,7 @@ def test_a_proximal_iteration_that_does_not_settle_is_a_failed_step():
 
     problem = build_problem(scene_from_dict(scene_dict({**CHANGES,
                                                         "memory": prony((1200.0, 0.3, 0.2))})))
-    memory = problem.start_memory()
+    memory = start_memory(problem)
     operators = StepOperators.build(problem, memory)
     assert operators.shift is not None and 0.2 < operators.contraction <= 0.3
     state = initial_state(problem, memory)

@@ -19,6 +19,7 @@ from test_cli import strict_json
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.scheme import STEP_FAILED
 from adhesive_contact.scheme.level_checks import WALL_SLACK, check_level
+from adhesive_contact.scheme.memory import start_memory
 from adhesive_contact.step_methods import (
     MAX_ITERATIONS,
     METHODS,
@@ -183,7 +184,7 @@ def test_slip_weakening_each_method_reports_how_it_ended():
 def test_the_interface_and_the_old_import_agree():
     problem, sol = run("newton", (TRESCA,), SHEAR, steps=1)
     from adhesive_contact.scheme.operators import StepOperators
-    ops = StepOperators.build(problem, problem.start_memory())
+    ops = StepOperators.build(problem, start_memory(problem))
     step = ops.at(1)
     c = step.reduce(ops.to_frames(problem.loads(1.0)))
     from adhesive_contact.scheme.state import ContactStep

@@ -18,7 +18,7 @@ its part of the :class:`~.problem.Problem`:
 8. :func:`probes`: the probe map.
 
 A Problem is never changed by a run: each run starts its own memory
-history (:meth:`~.problem.Problem.start_memory`).
+history (:func:`adhesive_contact.scheme.memory.start_memory`).
 """
 
 import time

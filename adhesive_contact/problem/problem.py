@@ -7,7 +7,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..fem.assembly import Assembly, LoadMap
-from ..scheme.memory import make_memory
 from .smallness import smallness
 from .warnings import problem_warnings
 
@@ -41,10 +40,6 @@ class Problem:
     exact: object = None      # ManufacturedSolution, for scenes with [exact]
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
     _smallness: dict = field(default=None, repr=False)
-
-    def start_memory(self):
-        """A fresh memory history for one run (the rectangle rule's state)."""
-        return make_memory(self.scene.memory)
 
     @property
     def smallness(self):

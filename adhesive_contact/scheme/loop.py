@@ -11,6 +11,7 @@ rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
 import time
 
 from .level_checks import check_level, check_load
+from .memory import start_memory
 from .operators import StepOperators
 from .recorder import HistoryRecorder
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
@@ -43,7 +44,7 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     Solution : ``success``, ``status``, ``message`` say how the run ended.
     """
     t0 = time.perf_counter()
-    memory = problem.start_memory()
+    memory = start_memory(problem)
     operators = StepOperators.build(problem, memory)
     contact = (ContactStep(problem, operators.within) if problem.boundary is not None
                else None)

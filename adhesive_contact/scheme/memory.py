@@ -112,3 +112,9 @@ def make_memory(spec):
         return PronyMemory([t.tensor.lam for t in terms], [t.tensor.mu for t in terms],
                            [t.tau for t in terms])
     return FunctionMemory(spec.function, spec.tensor.lam, spec.tensor.mu)
+
+
+def start_memory(problem):
+    """A fresh memory history for one run of ``problem`` (the rectangle
+    rule's state): a Problem is never changed by a run."""
+    return make_memory(problem.scene.memory)

@@ -36,6 +36,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from adhesive_contact import build_problem, scene_from_dict  # noqa: E402
+from adhesive_contact.scheme.memory import start_memory  # noqa: E402
 from adhesive_contact.scheme.operators import StepOperators  # noqa: E402
 from adhesive_contact.scheme.state import ContactStep  # noqa: E402
 from adhesive_contact.step_methods import StepOptions, minimise  # noqa: E402
@@ -207,7 +208,7 @@ def starting_points(spread, tries=6, seed=0):
             doc["contact"]["friction"][0]["alpha"] = alpha
             doc["contact"]["normal"]["c"] = c
             problem = build_problem(scene_from_dict(doc))
-            ops = StepOperators.build(problem, problem.start_memory())
+            ops = StepOperators.build(problem, start_memory(problem))
             step = ops.at(1)
             rhs = step.reduce(ops.to_frames(problem.loads(problem.times[1])))
             contact = ContactStep(problem)
