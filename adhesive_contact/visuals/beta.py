@@ -54,10 +54,12 @@ def beta_space_time(problem, beta, length="units of length"):
     edges = np.linspace(lo, hi, nbins + 1)
     which = np.clip(np.searchsorted(edges, mid[axis], side="right") - 1, 0, nbins - 1)
     weight = np.bincount(which, boundary.measure, minlength=nbins)
-    image = np.full((beta.shape[0], nbins), np.nan)
-    for n in range(beta.shape[0]):
-        sums = np.bincount(which, boundary.measure * beta[n], minlength=nbins)
-        image[n, weight > 0] = sums[weight > 0] / weight[weight > 0]
+    levels = beta.shape[0]
+    cells = np.arange(levels)[:, None] * nbins + which          # (N+1, nf): level and bin
+    sums = np.bincount(cells.ravel(), (boundary.measure * beta).ravel(),
+                       minlength=levels * nbins).reshape(levels, nbins)
+    image = np.full((levels, nbins), np.nan)
+    image[:, weight > 0] = sums[:, weight > 0] / weight[weight > 0]
     return edges, np.ma.masked_invalid(image), (f"{name} of the facet midpoint ({length}); "
                                                 "β averaged across Γ_C")
 
