@@ -4,27 +4,24 @@
 The study is :class:`adhesive_contact.studies.ConvergenceStudy` (what to
 (re)compute, the folder ``--out`` that keeps it, errors.csv and
 rates.json); this module parses the options, shows progress, prints the
-table and draws ``error_vs_h.png`` (or ``error_vs_k.png``) and
-``work_precision.png`` from the results document, each written atomically.
+table and has :mod:`adhesive_contact.visuals` draw ``error_vs_h.png`` (or
+``error_vs_k.png``) and ``work_precision.png`` from the results document.
 """
 
 import math
 import sys
-import textwrap
 from pathlib import Path
 
 import click
-import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
-import numpy as np
-from matplotlib.ticker import NullFormatter  # noqa: E402
 
 from adhesive_contact.verification.levels import PARAMS, level_scene
-from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     ConvergenceStudy,
     RunFailed,
 )
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
+from adhesive_contact.visuals import write_convergence_plots
+from adhesive_contact.visuals.studies import reference_phrase
 
 from .common import (
     CliError,
@@ -38,7 +35,6 @@ from .common import (
     scene_folder,
     study_source,
 )
-from .plots import DPI, Units, plot_title
 from .scheduler import open_executor, scheduler_option
 
 # ---------------------------------------------------------------- the table
@@ -89,141 +85,6 @@ def table(document):
                  + (f"  (only {n} levels: a meaningful rate needs >= {MEANINGFUL_LEVELS})"
                     if n < MEANINGFUL_LEVELS else ""))
     return lines
-
-
-# ---------------------------------------------------------------- plots
-
-ERRORS = (("err_u", "‖ε(u − u_h)‖", "u", "o"), ("err_beta", "‖β − β_h‖", "beta", "s"),
-          ("E", "E = ‖ε(u − u_h)‖ + ‖β − β_h‖", "E", "^"))
-
-
-def _positive(x, y):
-    x, y = np.asarray(x, float), np.array([np.nan if v is None else v for v in y], float)
-    ok = np.isfinite(y) & (y > 0) & (x > 0)
-    return x[ok], y[ok]
-
-
-def _reference_phrase(info):
-    if info["kind"] == "exact":
-        return "reference: the scene's exact solution"
-    return (f"reference: fine run (refine {info['refine']}, {info['steps']} steps, "
-            f"{info['seconds']:.3g} s)")
-
-
-def _suptitle(fig, document, title):
-    wrapped = textwrap.fill(plot_title(title), 70)
-    fig.suptitle(f"{wrapped}\n{document['param']}-refinement, {len(document['levels'])} "
-                 f"levels; {_reference_phrase(document['reference'])}", fontsize="medium")
-
-
-def _slope_one_triangle(ax, xs, ys):
-    """A slope-1 triangle under the data, in the left half of the x range."""
-    lo, hi = np.log(xs.min()), np.log(xs.max())
-    if hi - lo < 1e-12:
-        return
-    x1, x2 = np.exp(lo + 0.15 * (hi - lo)), np.exp(lo + 0.5 * (hi - lo))
-    y1 = 0.4 * ys.min()
-    y2 = y1 * x2 / x1
-    ax.plot([x1, x2, x2, x1], [y1, y1, y2, y1], "-", color="0.45", linewidth=1.0,
-            label="slope 1 (guide)")
-    ax.set_ylim(bottom=0.55 * y1)   # room for the label under the triangle
-    ax.text(np.sqrt(x1 * x2), y1 * 0.85, "1", ha="center", va="top", color="0.35",
-            fontsize="small")
-    ax.text(x2 * 1.04, np.sqrt(y1 * y2), "1", ha="left", va="center", color="0.35",
-            fontsize="small")
-
-
-def figure_error_vs_size(document, title, units=None):
-    """Errors against h (or k) log-log, with the fitted slopes in the legend;
-    ``units`` (:class:`~.plots.Units`) name the unit of h and k."""
-    units = units or Units()
-    param = document["param"]
-    size = "k" if param == "k" else "h"
-    rows = document["levels"]
-    fig, ax = plt.subplots(figsize=(7.0, 5.0))
-    drawn = []
-    for key, label, rate_key, marker in ERRORS:
-        x, y = _positive([r[size] for r in rows], [r[key] for r in rows])
-        if y.size == 0:
-            continue
-        slope = document["rates"][rate_key]
-        ax.loglog(x, y, marker + "-", label=f"{label}   slope {_fmt(slope, '.2f', 'n/a')}")
-        drawn.append((x, y))
-    if drawn:
-        _slope_one_triangle(ax, np.concatenate([d[0] for d in drawn]),
-                            np.concatenate([d[1] for d in drawn]))
-        ax.legend(fontsize="small", loc="best")
-    else:
-        ax.text(0.5, 0.5, "all errors are zero", transform=ax.transAxes, ha="center")
-    ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short axes
-    length, time = units.suffix("length"), units.suffix("time")
-    ax.set_xlabel({"h": f"mesh size h{length}", "k": f"time step k{time}",
-                   "hk": f"mesh size h{length} (time step k halved with h)"}[param])
-    ax.set_ylabel("error, max over the time grid")
-    _finish(fig, ax, document, title)
-    return fig
-
-
-def _finish(fig, ax, document, title):
-    """Grid and titles."""
-    ax.grid(True, which="both", color="0.9", linewidth=0.6)
-    _suptitle(fig, document, title)
-
-
-def _save(fig, path):
-    """The PNG written atomically; the figure closed."""
-    try:
-        write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI,
-                                                 bbox_inches="tight"), binary=True)
-    finally:
-        plt.close(fig)
-
-
-def plot_error_vs_size(path, document, title, units=None):
-    """``error_vs_h.png`` (or ``error_vs_k.png``): :func:`figure_error_vs_size`."""
-    _save(figure_error_vs_size(document, title, units), path)
-
-
-def figure_work_precision(document, title):
-    """E against the wall time of each level's run, log-log."""
-    rows = document["levels"]
-    info = document["reference"]
-    fig, ax = plt.subplots(figsize=(7.0, 5.0))
-    x, y = _positive([r["seconds"] for r in rows], [r["E"] for r in rows])
-    if y.size:
-        ax.loglog(x, y, "^-", label="E, max over the time grid")
-        for r in rows:
-            if r["E"] is not None and r["E"] > 0 and r["seconds"] > 0:
-                ax.annotate(f"level {r['level']}\n{r['dofs']} dofs, {r['steps']} steps",
-                            (r["seconds"], r["E"]), textcoords="offset points",
-                            xytext=(6, 4), fontsize="x-small", color="0.3")
-    if info["kind"] == "fine" and info["seconds"] > 0:
-        ax.axvline(info["seconds"], linestyle="--", color="0.5",
-                   label=f"reference run: {info['seconds']:.3g} s")
-        ax.set_xscale("log")
-    if y.size or info["kind"] == "fine":
-        ax.legend(fontsize="small", loc="best")
-    ax.margins(x=0.12, y=0.15)   # room for the annotations
-    ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel("wall time of the level's run (s): assembly and time stepping")
-    ax.set_ylabel("error E")
-    _finish(fig, ax, document, title)
-    return fig
-
-
-def plot_work_precision(path, document, title):
-    """``work_precision.png``: :func:`figure_work_precision`."""
-    _save(figure_work_precision(document, title), path)
-
-
-def write_plots(out, document, title, units=None):
-    """Draw the two figures of a study into ``out``; return their names.
-    ``units``: the scene's ``[output] units`` (a dict), naming h's and k's."""
-    size = "k" if document["param"] == "k" else "h"
-    names = [f"error_vs_{size}.png", "work_precision.png"]
-    plot_error_vs_size(out / names[0], document, title, Units(units))
-    plot_work_precision(out / names[1], document, title)
-    return names
 
 
 # ---------------------------------------------------------------- the command
@@ -301,8 +162,8 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     try:
         with running_study(out, executor, "levels"):
             result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
-            files = result.files + write_plots(out, result.document, study.scene.title,
-                                               study.scene.units)
+            files = result.files + write_convergence_plots(
+                out, result.document, study.scene.title, study.scene.units)
     except RunFailed as err:
         raise CliError(str(err), 1) from None
     finally:
@@ -313,7 +174,7 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     if result.reference_loaded:
         click.echo(f"reference: loaded from {out / 'reference.npz'}", err=True)
     click.echo(study.scene.title)
-    click.echo(f"  {_reference_phrase(document['reference'])}; {computed} of {levels} levels "
+    click.echo(f"  {reference_phrase(document['reference'])}; {computed} of {levels} levels "
                f"computed now, {levels - computed} loaded")
     for line in table(document):
         click.echo("  " + line)

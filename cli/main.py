@@ -11,11 +11,16 @@ interrupted writes the levels it finished, marked partial in summary.json
 existing one file by file, touching no other file). What the theory does
 not cover for a valid scene (``Problem.warnings()``) is reported as one
 line ``warning: ...`` each on stderr before the time loop, and the run
-goes on."""
+goes on.
+
+The figures are drawn by :mod:`adhesive_contact.visuals` into PNG files:
+a command selects matplotlib's Agg backend (:func:`draw_to_files`), no
+display is needed."""
 
 import contextlib
 import importlib
 import io
+import os
 import signal
 import sys
 import threading
@@ -45,12 +50,27 @@ LAZY_COMMANDS = {
 }
 
 
+def draw_to_files():
+    """Select matplotlib's Agg backend for the figures of a command: PNG
+    files, no display.
+
+    The CLI does not import matplotlib: the choice is ``MPLBACKEND``, which
+    matplotlib reads when it is first imported (by the library, when a
+    command draws). A process that imported matplotlib before running a
+    command in it (a notebook calling :func:`main`) keeps its own backend.
+    """
+    if "matplotlib" not in sys.modules:
+        os.environ["MPLBACKEND"] = "Agg"
+
+
 class OneLineGroup(click.Group):
     """A click group whose errors (usage errors too) are one line on stderr."""
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True,
              **extra):
-        """Run the group; in standalone mode report errors as one line and exit."""
+        """Run the group (figures drawn on the Agg backend, :func:`draw_to_files`);
+        in standalone mode report errors as one line and exit."""
+        draw_to_files()
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, False, **extra)
         try:

@@ -15,7 +15,7 @@ adds the rest:
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
 - ``solution.xdmf`` + ``solution.h5`` and ``contact.xdmf`` + ``contact.h5``
   (:mod:`adhesive_contact.io.xdmf`), written by the recorder;
-- PNG plots (:mod:`.plots`).
+- PNG plots (:func:`adhesive_contact.visuals.write_plots`).
 """
 
 import contextlib
@@ -31,8 +31,8 @@ from adhesive_contact.resources import estimate
 from adhesive_contact.problem.warnings import solution_warnings
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
+from adhesive_contact.visuals import PLOT_NAMES, write_plots
 
-from . import plots
 from .postprocess import smallness_record, step_records
 
 #: the version of summary.json's layout (docs/outputs.md): raised when a key
@@ -113,7 +113,7 @@ def write_summary(solution, path, source=None):
 #: run replaces these and touches nothing else
 OUTPUT_NAMES = frozenset(
     ["summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
-     "contact.h5"] + [f"{name}.png" for name in plots.PLOT_NAMES])
+     "contact.h5"] + [f"{name}.png" for name in PLOT_NAMES])
 
 
 def _publish(staging, target):
@@ -205,7 +205,7 @@ def write_results(solution, folder, failures=None, source=None):
     folder = Path(folder)
     write_summary(solution, folder / "summary.json", source)
     write_npz(solution, folder / "solution.npz")
-    return ["summary.json", "solution.npz"] + plots.write_plots(solution, folder, failures)
+    return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures)
 
 
 def write_outputs(solution, out, failures=None, source=None):

@@ -2,25 +2,23 @@
 
 The sweep is :class:`adhesive_contact.studies.Sweep` (variants, validation,
 the folder ``--out`` that keeps it, runs.csv); this module parses the
-options, shows progress, prints one line per run and draws one figure per
-swept key (``by_<key>.png``), each written atomically.
+options, shows progress, prints one line per run and has
+:mod:`adhesive_contact.visuals` draw one figure per swept key
+(``by_<key>.png``).
 """
 
-import math
 import sys
 from pathlib import Path
 
 import click
-import matplotlib.pyplot as plt  # noqa: E402  (after .plots: the Agg backend)
-import numpy as np
 
 from adhesive_contact import SceneError, scene_from_dict
-from adhesive_contact.storage import write_atomic
 from adhesive_contact.studies import (
     Sweep,
     parse_assignment,
 )
 from adhesive_contact.studies.sweep import LOST, show, variant_document, variants
+from adhesive_contact.visuals import write_sweep_plots
 
 from .common import (
     check_out,
@@ -32,95 +30,7 @@ from .common import (
     scene_folder,
     study_source,
 )
-from .plots import DPI, Units, plot_title
 from .scheduler import open_executor, scheduler_option
-
-#: the panels of each figure: (runs.csv column, axis label)
-PANELS = (("seconds", "wall time of the run (s)"),
-          ("newton_total", "Newton iterations, all steps"),
-          ("beta_mean_T", "mean bonding β at T"),
-          ("normal_force_T", "total normal contact force at T\n(> 0 compression{force})"))
-
-
-def panel_label(label, units, dim):
-    """A panel's axis label; the force's unit (``[output] units``) filled in:
-    "; N", "; N/mm per unit thickness" in 2D, or nothing without units."""
-    force, length = units.given.get("force"), units.given.get("length")
-    if force is None:
-        unit = ""
-    elif dim == 3:
-        unit = f"; {force}"
-    else:
-        unit = f"; {force}/{length}" if length else f"; {force} per unit thickness"
-    return label.format(force=unit)
-
-
-def _numbers(values):
-    """The values as floats when all are numbers (not bools), else None."""
-    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
-        return np.asarray(values, dtype=float)
-    return None
-
-
-def _value(row, column):
-    value = row[column]
-    return math.nan if value is None else float(value)
-
-
-def figure_key(rows, keys, key, title, units=None, dim=2):
-    """The measured quantities against one swept key, a line per setting of
-    the others; ``units`` (:class:`~.plots.Units`) of the base scene, of
-    dimension ``dim``, name the force's unit."""
-    units = units or Units()
-    values = list(dict.fromkeys(show(row[key]) for row in rows))
-    raw = {show(row[key]): row[key] for row in rows}
-    numbers = _numbers([raw[v] for v in values])
-    position = ({v: x for v, x in zip(values, numbers)} if numbers is not None
-                else {v: i for i, v in enumerate(values)})
-    others = [k for k in keys if k != key]
-    groups = {}
-    for row in rows:
-        label = ", ".join(f"{k} = {show(row[k])}" for k in others)
-        groups.setdefault(label, []).append(row)
-    fig, axes = plt.subplots(2, 2, figsize=(10.5, 7.5), sharex=True, layout="constrained")
-    for (column, label), ax in zip(PANELS, axes.ravel()):
-        for group, members in groups.items():
-            members = sorted(members, key=lambda r: position[show(r[key])])
-            x = np.array([position[show(r[key])] for r in members], dtype=float)
-            ok = np.array([r["outcome"] == "ok" for r in members])
-            y = np.array([_value(r, column) for r in members])
-            ax.plot(x[ok], y[ok], "o-", label=group or None)
-            if column == "seconds" and (~ok).any():
-                ax.plot(x[~ok], y[~ok], "x", color="tab:red", markersize=9, mew=2)
-        ax.set_ylabel(panel_label(label, units, dim))
-        ax.grid(True, color="0.9", linewidth=0.6)
-    if numbers is not None and numbers.min() > 0 and numbers.max() > 10 * numbers.min():
-        axes[0, 0].set_xscale("log")
-    if numbers is None:
-        axes[1, 0].set_xticks(range(len(values)), values)
-    for ax in axes[1]:
-        ax.set_xlabel(key)
-    handles = axes[0, 0].get_legend_handles_labels()[0]
-    if any(label for label in groups) and handles:
-        fig.legend(handles, list(groups), loc="outside lower center", fontsize="small",
-                   title="other settings", ncols=min(3, len(groups)))
-    failed = sum(row["outcome"] != "ok" for row in rows)
-    note = f"; × on the time panel: {failed} failed run(s)" if failed else ""
-    fig.suptitle(f"{plot_title(title)}\nsweep over {key}{note}", fontsize="medium")
-    return fig
-
-
-def plot_key(path, rows, keys, key, title, units=None, dim=2):
-    """``by_<key>.png``: :func:`figure_key`, written atomically."""
-    fig = figure_key(rows, keys, key, title, units, dim)
-    try:
-        write_atomic(path, lambda f: fig.savefig(f, format="png", dpi=DPI), binary=True)
-    finally:
-        plt.close(fig)
-
-
-def plot_name(key):
-    return f"by_{key}.png"
 
 
 def _fmt(value, spec):
@@ -220,11 +130,8 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
             bar.update(done - bar.pos)
         with running_study(out, executor, "runs"):
             result = study.run(jobs=jobs or 1, executor=executor, progress=progress)
-            files = list(result.files)
-            for key in keys:
-                files.append(plot_name(key))
-                plot_key(out / files[-1], result.rows, keys, key, study.base.title,
-                         Units(study.base.units), study.base.dim)
+            files = list(result.files) + write_sweep_plots(
+                out, result.rows, keys, study.base.title, study.base.units, study.base.dim)
 
     failed = sum(row["outcome"] == "failed" for row in result.rows)
     lost = len(result.lost)

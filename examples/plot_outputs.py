@@ -10,7 +10,9 @@ summary.json), so the library's post-processing works on it. It draws β
 along the contact side at a few times and the total normal force over time
 into beta_and_force.png, beside the outputs when FOLDER is given, else in
 the temporary folder. (The files are plain too: ``numpy.load`` and
-``json.load`` read them, docs/outputs.md.)
+``json.load`` read them, docs/outputs.md.) The package's own figures of
+the run are ``adhesive_contact.visuals`` (docs/python.md, "Figures"):
+``visuals.figure_beta(solution)`` draws ``beta.png`` again from the folder.
 """
 
 import subprocess

@@ -11,6 +11,7 @@ import copy
 import json
 import re
 
+import matplotlib
 import numpy as np
 import pytest
 from skfem import (
@@ -26,6 +27,10 @@ from skfem import (
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
+
+# the tests draw figures into files and read them: no display, whatever the
+# machine has (the library chooses no backend, tests/test_visuals.py)
+matplotlib.use("Agg")
 
 # ---------------------------------------------------------------- scene documents
 

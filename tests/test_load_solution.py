@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from adhesive_contact_cli import plots
 from adhesive_contact_cli.main import main
 from conftest import glued_contact, runner, scene_dict, to_toml, wall_block
 
@@ -23,6 +22,7 @@ from adhesive_contact import (
     solve,
 )
 from adhesive_contact.scheme import STEP_FAILED, SUCCESS
+from adhesive_contact.visuals import write_plots
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -95,7 +95,7 @@ def test_a_solved_folder_loads_as_the_solution_solve_returns(tmp_path, document)
     drawn = tmp_path / "drawn"
     drawn.mkdir()
     failures = []
-    assert set(plots.write_plots(loaded, drawn, failures)) == {p.name for p in out.glob("*.png")}
+    assert set(write_plots(loaded, drawn, failures)) == {p.name for p in out.glob("*.png")}
     assert failures == []
     # the problem may be given: no rebuilding
     again = load_solution(out, problem=direct.problem)

@@ -13,7 +13,6 @@ import time
 import numpy as np
 import pytest
 from adhesive_contact_cli import output as output_module
-from adhesive_contact_cli import plots
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
 from conftest import DELETE, law, prony, scene_dict, to_toml
@@ -27,6 +26,8 @@ from adhesive_contact import (
     solve,
 )
 from adhesive_contact.verification import manufactured
+from adhesive_contact.visuals import common as figure_common
+from adhesive_contact.visuals import solution as run_figures
 
 BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
                     "contact.normal": law("compliance", c=100.0), "time.steps": 2})
@@ -234,14 +235,14 @@ def test_a_dollar_in_the_title_is_drawn(tmp_path):
     result, out = solve_scene(tmp_path, scene_dict({"title": "$x^$ and $"}, BLOCK))
     assert result.exit_code == 0, result.stderr
     assert {"deformed.png", "beta.png", "contact_traction.png"} <= set(os.listdir(out))
-    assert plots.plot_title("$x^$") == r"\$x^\$"
-    assert len(plots.plot_title("a" * 500)) == plots.TITLE_CHARS
+    assert figure_common.plot_title("$x^$") == r"\$x^\$"
+    assert len(figure_common.plot_title("a" * 500)) == figure_common.TITLE_CHARS
 
 
 def test_a_plot_that_fails_is_a_warning_and_the_data_is_kept(tmp_path, monkeypatch):
     def broken(solution, path):
         raise RuntimeError("no font")
-    monkeypatch.setattr(plots, "plot_beta", broken)
+    monkeypatch.setattr(run_figures, "plot_beta", broken)
     result, out = solve_scene(tmp_path, BLOCK)
     assert result.exit_code == 0, result.stderr
     assert "warning: beta.png was not drawn: RuntimeError: no font" in result.stderr

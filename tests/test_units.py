@@ -9,9 +9,6 @@ import matplotlib.pyplot as plt
 import matplotlib.text
 import numpy as np
 import pytest
-from adhesive_contact_cli import converge as converge_cli
-from adhesive_contact_cli import plots
-from adhesive_contact_cli import sweep as sweep_cli
 from adhesive_contact_cli.main import main
 from conftest import (
     assert_one_line_error,
@@ -24,8 +21,10 @@ from conftest import (
 )
 from matplotlib.patches import StepPatch
 
-from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
+from adhesive_contact import SceneError, build_problem, scene_from_dict, solve, visuals
 from adhesive_contact.studies.study import scene_identity
+from adhesive_contact.visuals import deformed as deformed_figure
+from adhesive_contact.visuals import studies as study_figures
 
 UNITS = {"length": "mm", "stress": "MPa", "time": "s", "force": "N"}
 
@@ -71,15 +70,15 @@ def box():
 
 
 def figures(solution):
-    out = {"deformed": plots.figure_deformed(solution)}
+    out = {"deformed": visuals.figure_deformed(solution)}
     boundary = solution.problem.boundary
     if boundary is not None and boundary.nodes.size:
-        out["contact_traction"] = plots.figure_contact_traction(solution)
-        out["beta"] = plots.figure_beta(solution)
+        out["contact_traction"] = visuals.figure_contact_traction(solution)
+        out["beta"] = visuals.figure_beta(solution)
     if solution.problem.dim == 3:
-        out["contact_map"] = plots.figure_contact_map(solution)
-    if plots.load_curves(solution):
-        out["load_displacement"] = plots.figure_load_displacement(solution)
+        out["contact_map"] = visuals.figure_contact_map(solution)
+    if visuals.load_curves(solution):
+        out["load_displacement"] = visuals.figure_load_displacement(solution)
     return out
 
 
@@ -154,9 +153,9 @@ def test_without_units_the_axes_keep_the_scene_wording(glued):
 
 
 def test_beta_curves_have_no_end_lines_and_the_mean_is_defined(glued):
-    fig = plots.figure_beta(glued["with"])
+    fig = visuals.figure_beta(glued["with"])
     steps = [a for a in fig.axes[0].get_children() if isinstance(a, StepPatch)]
-    assert len(steps) == np.union1d([0], plots.sample_levels(2)).size   # level 0, samples
+    assert len(steps) == np.union1d([0], visuals.common.sample_levels(2)).size   # level 0, samples
     assert all(step.get_data().baseline is None for step in steps)
     legend = [t.get_text() for t in fig.axes[3].get_legend().get_texts()]
     assert legend[0] == "mean over Γ_C (weighted by facet length)"
@@ -202,7 +201,7 @@ def capture(monkeypatch, module, name):
 def test_solve_records_the_units_and_draws_with_them(tmp_path, monkeypatch):
     scene = tmp_path / "glued.toml"
     scene.write_text(to_toml(scene_dict({"output.units": UNITS}, GLUED)))
-    made = capture(monkeypatch, plots, "figure_deformed")
+    made = capture(monkeypatch, deformed_figure, "figure_deformed")
     result = run("solve", scene, "--out", tmp_path / "out", "--quiet")
     assert result.exit_code == 0, result.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
@@ -225,31 +224,31 @@ def test_converge_names_the_unit_of_h(tmp_path, monkeypatch):
         "mesh.size": [1.0, 0.5], "mesh.cells": [2, 1], "boundary": {"dirichlet": ["left"]},
         "memory": prony((200.0, 0.3, 0.5)), "time.steps": 2,
         "exact.u": ["0.01*x*x*(1+t)", "0.005*x*y"], "output.units": UNITS})))
-    made = capture(monkeypatch, converge_cli, "figure_error_vs_size")
+    made = capture(monkeypatch, study_figures, "figure_error_vs_size")
     result = run("converge", scene, "--param", "h", "--levels", "2", "--out", tmp_path / "c")
     assert result.exit_code == 0, result.stderr
     assert made[0].axes[0].get_xlabel() == "mesh size h (mm)"
     document = json.loads((tmp_path / "c" / "rates.json").read_text())
     k_study = dict(document, param="k")
-    assert converge_cli.figure_error_vs_size(k_study, "t", plots.Units(UNITS)).axes[0] \
+    assert visuals.figure_error_vs_size(k_study, "t", visuals.Units(UNITS)).axes[0] \
         .get_xlabel() == "time step k (s)"
-    assert converge_cli.figure_error_vs_size(k_study, "t").axes[0].get_xlabel() == "time step k"
+    assert visuals.figure_error_vs_size(k_study, "t").axes[0].get_xlabel() == "time step k"
 
 
 def test_sweep_names_the_unit_of_the_force(tmp_path, monkeypatch):
     scene = tmp_path / "block.toml"
     scene.write_text(to_toml(scene_dict({"output.units": UNITS, "mesh.cells": [4, 2]},
                                         wall_block())))
-    made = capture(monkeypatch, sweep_cli, "figure_key")
+    made = capture(monkeypatch, study_figures, "figure_by_key")
     result = run("sweep", scene, "--set", "contact.normal.c=1e3,2e3", "--out", tmp_path / "s")
     assert result.exit_code == 0, result.stderr
     force = [ax.get_ylabel() for ax in made[0].axes if "normal contact force" in ax.get_ylabel()]
     assert force == ["total normal contact force at T\n(> 0 compression; N/mm)"]
     rows = [{"outcome": "ok", "k": 1.0, "normal_force_T": 1.0, "seconds": 1.0,
              "newton_total": 1, "beta_mean_T": 1.0}]
-    plain = sweep_cli.figure_key(rows, ["k"], "k", "t")
+    plain = visuals.figure_by_key(rows, ["k"], "k", "t")
     assert "total normal contact force at T\n(> 0 compression)" in [
         ax.get_ylabel() for ax in plain.axes]
-    three = sweep_cli.figure_key(rows, ["k"], "k", "t", plots.Units(UNITS), dim=3)
+    three = visuals.figure_by_key(rows, ["k"], "k", "t", visuals.Units(UNITS), dim=3)
     assert "total normal contact force at T\n(> 0 compression; N)" in [
         ax.get_ylabel() for ax in three.axes]

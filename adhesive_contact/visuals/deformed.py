@@ -1,0 +1,114 @@
+"""``deformed.png``: the deformed mesh at the final time, coloured by the von
+Mises stress."""
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.tri import Triangulation
+
+from ..postprocess import cell_von_mises
+from .common import Units, save_figure, solution_title, tidy_3d_axes
+
+#: the von Mises stress of the colour bars: of the whole 3 × 3 stress
+VON_MISES = "von Mises stress"
+
+
+def magnification(points, u):
+    """A round factor making max |u| about 10% of the domain's largest extent
+    (1 when the displacements are larger than that already).
+
+    Parameters
+    ----------
+    points : (d, npoints) reference coordinates
+    u : (npoints, d) displacements
+    """
+    extent = float((points.max(axis=1) - points.min(axis=1)).max())
+    umax = float(np.linalg.norm(u, axis=1).max(initial=0.0))
+    if umax == 0.0 or not np.isfinite(umax):
+        return 1.0
+    # large displacements are drawn as they are, never shrunk
+    return max(1.0, float(f"{0.1 * extent / umax:.2g}"))
+
+
+def _deformed_2d(fig, ax, solution, factor, units):
+    mesh = solution.problem.mesh
+    p = mesh.p + factor * solution.u[-1].T
+    vm = cell_von_mises(solution, -1)
+    tri = Triangulation(p[0], p[1], mesh.t.T)
+    image = ax.tripcolor(tri, facecolors=vm, cmap="viridis", shading="flat")
+    ax.triplot(tri, color="k", linewidth=0.2, alpha=0.4)
+    outline = mesh.p[:, mesh.facets[:, mesh.boundary_facets()]].transpose(2, 1, 0)
+    ax.add_collection(LineCollection(outline, colors="0.4", linestyles="--", linewidths=0.8,
+                                     label="reference configuration"))
+    boundary = solution.problem.boundary
+    if boundary is not None and solution.on_wall[-1].any():
+        on = boundary.nodes[solution.on_wall[-1]]
+        ax.plot(p[0, on], p[1, on], "o", color="tab:red", markersize=3,
+                label="contact nodes on the wall")
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x ({units.length})")
+    ax.set_ylabel(f"y ({units.length})")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")
+    # below the axes: a colorbar as wide as a flat domain, never taller than it
+    fig.colorbar(image, ax=ax, location="bottom", shrink=0.7, pad=0.14, aspect=35,
+                 label=f"{VON_MISES} (plane strain: σ_zz included; {units.stress})")
+
+
+def _deformed_3d(fig, solution, factor, units):
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    mesh = solution.problem.mesh
+    ax = fig.add_subplot(projection="3d")
+    p = mesh.p + factor * solution.u[-1].T
+    faces = mesh.boundary_facets()
+    vm = cell_von_mises(solution, -1)[mesh.f2t[0, faces]]
+    norm = plt.Normalize(vm.min(), vm.max())
+    polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
+    ax.add_collection3d(Poly3DCollection(polys, facecolors=plt.cm.viridis(norm(vm)),
+                                         edgecolors="k", linewidths=0.1))
+    low, high = p.min(axis=1), p.max(axis=1)
+    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+    tidy_3d_axes(ax)
+    ax.set_box_aspect(high - low)
+    mappable = plt.cm.ScalarMappable(norm=norm, cmap="viridis")
+    fig.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12,
+                 label=f"{VON_MISES} ({units.stress})")
+    return ax
+
+
+def figure_deformed(solution):
+    """The deformed mesh at the final time, coloured by the von Mises stress
+    of σ (in 2D with the plane-strain σ_zz).
+
+    2D: the cells at x + f u(T), the reference outline dashed and the
+    contact nodes on the wall as red dots; 3D: the boundary faces of the
+    deformed body. The factor f is :func:`magnification` (1: to scale).
+
+    Parameters
+    ----------
+    solution : adhesive_contact.Solution
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    mesh = solution.problem.mesh
+    units = Units.of(solution)
+    factor = magnification(mesh.p, solution.u[-1])
+    fig = plt.figure(figsize=(9, 5))
+    if mesh.dim() == 2:
+        ax = fig.add_subplot()
+        _deformed_2d(fig, ax, solution, factor, units)
+    else:
+        ax = _deformed_3d(fig, solution, factor, units)
+    scale = ("displacements to scale" if factor == 1.0 else
+             f"displacements magnified ×{factor:g}")
+    coordinates = f"; x, y, z in {units.length}" if mesh.dim() == 3 else ""
+    ax.set_title(f"{solution_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, "
+                 f"{scale}{coordinates}", fontsize="medium")
+    return fig
+
+
+def plot_deformed(solution, path):
+    """``deformed.png``: :func:`figure_deformed` saved into ``path``."""
+    save_figure(figure_deformed(solution), path)
