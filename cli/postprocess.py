@@ -44,7 +44,7 @@ def step_records(solution):
     and slip are None without friction);
     max_penetration is max_a (u_ν − g), None without a wall; ``reactions``
     is {side: [F_x, F_y(, F_z)]}, the force each held side's support exerts
-    on the body (:mod:`adhesive_contact.reactions`), and ``contact_force``
+    on the body (:mod:`adhesive_contact.postprocess.reactions`), and ``contact_force``
     the total force of Γ_C on the body in global components (None without
     contact nodes).
     """

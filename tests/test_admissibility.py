@@ -1,5 +1,5 @@
 """Manufactured solutions are checked for admissibility before a run
-(adhesive_contact.admissibility): u* = 0 on the clamped sides, u*_ν ≤ g,
+(adhesive_contact.verification.admissibility): u* = 0 on the clamped sides, u*_ν ≤ g,
 λ* ≥ 0 where u*_ν = g (found with a tolerance), 0 ≤ β* ≤ 1, and no
 stick/slip ambiguity of friction with a kink. A violation is a SceneError
 naming the condition and the point (exit 2 on the command line)."""

@@ -1,4 +1,4 @@
-"""Φ of a step (adhesive_contact.contact_energy) against finite differences:
+"""Φ of a step (adhesive_contact.scheme.contact_energy) against finite differences:
 its gradient against its value and its Hessian against its gradient, in 2D
 and 3D, nodal and Gauss quadrature; and the Hessian's linear map against
 the sparse products it replaces."""

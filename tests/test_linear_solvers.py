@@ -3,7 +3,7 @@ the automatic choice, and the rigid body modes of AMG.
 
 Matrices: P1 elasticity stiffness λ K_λ + μ K_μ (E = 1000, ν = 0.3) of a
 2D rectangle and a 3D box, clamped on the side x = 0, assembled by
-:class:`adhesive_contact.assembly.Assembly`.
+:class:`adhesive_contact.fem.assembly.Assembly`.
 """
 
 import gc

@@ -1,4 +1,4 @@
-"""The smallness conditions of the theory (adhesive_contact.smallness):
+"""The smallness conditions of the theory (adhesive_contact.problem.smallness):
 the trace constant of the mesh actually run, and the existence, estimate
 and convexity conditions side by side."""
 

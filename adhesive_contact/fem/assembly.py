@@ -9,7 +9,7 @@ so the elastic tensor A, the memory tensors C_m and the step matrix
 a_n = A + k R(0) of docs/scheme.md ('What a step solves') are all combinations of two matrices
 assembled once. Loads ⟨f(t), v⟩ = (f_0, v)_Ω + (f_N, v)_{Γ_N} are the
 load expressions evaluated at fixed quadrature points and contracted with
-the test functions' values there (:class:`~adhesive_contact.p1.CellLoad`
+the test functions' values there (:class:`~adhesive_contact.fem.p1.CellLoad`
 in Ω, a fixed sparse map on Γ_N), so a step costs one evaluation and one
 contraction; a body force constant in space costs neither.
 """
@@ -163,7 +163,7 @@ class LoadMap:
 
 class Assembly:
     """The per-mesh operators of the fully discrete scheme, from the
-    vectorised P1 kernels of :mod:`adhesive_contact.p1` (the forms above
+    vectorised P1 kernels of :mod:`adhesive_contact.fem.p1` (the forms above
     give the same matrices; a test compares them)."""
 
     def __init__(self, mesh):

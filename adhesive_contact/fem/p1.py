@@ -11,7 +11,7 @@ vector dofs (i, a) ↦ d·node_i + a and u = φ_i e_a:
 
 so the stiffness parts are exact with no quadrature at all, and are built
 from one array of element matrices and one sparse conversion each. The
-same quantities from scikit-fem's forms (:mod:`adhesive_contact.assembly`)
+same quantities from scikit-fem's forms (:mod:`adhesive_contact.fem.assembly`)
 agree to round-off (a test); these kernels are several times faster.
 """
 
@@ -112,7 +112,7 @@ def stiffness_parts(mesh, geometry=None):
     """(K_λ, K_μ): ∫ div u div v and ∫ 2 ε(u):ε(v) for vector P1, as block
     (BSR) matrices of d × d blocks on one node pattern (a combination
     λ K_λ + μ K_μ is then one sum of their data and one conversion to CSR:
-    :meth:`~adhesive_contact.assembly.Assembly.stiffness`).
+    :meth:`~adhesive_contact.fem.assembly.Assembly.stiffness`).
 
     With g_i the gradients of the barycentric coordinates and |e| the cell
     measure, the element blocks are (K_λ)_ij^ab = |e| g_i[a] g_j[b] and

@@ -64,7 +64,7 @@ class AdhesiveCompliance:
     (2 γ β R_ν ≤ 2 γ L) never act together, so this is the sharp constant
     for |Δp| ≤ m_ν (|Δβ| + |Δr|), β ∈ [0, 1]. Being below the plain sum of
     the slopes, max(c + γ, 2 γ L), it keeps the smallness estimate of
-    :mod:`adhesive_contact.smallness` less conservative.
+    :mod:`adhesive_contact.problem.smallness` less conservative.
     """
 
     c: float

@@ -29,7 +29,7 @@ def rigid_body_modes(points, dofs=None):
         The mesh nodes, d = 2 or 3.
     dofs : (nfree,) int array, optional
         Indices into the interleaved P1 vector numbering, dof = d·node + c
-        (that of :class:`~adhesive_contact.assembly.Assembly`); all dofs if
+        (that of :class:`~adhesive_contact.fem.assembly.Assembly`); all dofs if
         omitted.
 
     Returns

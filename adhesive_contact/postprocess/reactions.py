@@ -1,7 +1,7 @@
 """Reaction forces of the supports, per held side.
 
 The scheme records, per level, the nodal reaction r_D = (a_n u_n)_D − f_D
-at each held dof (:mod:`adhesive_contact.dirichlet`): the force the
+at each held dof (:mod:`adhesive_contact.fem.dirichlet`): the force the
 support exerts on the body, with f the load minus the memory history's
 force. The held dofs are never rotated, so r_D is in global components.
 A side's reaction is the sum of the nodal reactions of its held

@@ -8,7 +8,7 @@ free dofs. Splitting them into contact dofs C and the rest I,
 the minimisation over u becomes one over the contact unknowns z = u_C
 only, ½ zᵀ S z − cᵀ z + contact terms; then u_I = A_II⁻¹ (b_I − A_IC z).
 (The caller writes the system in the nodal frames of
-:mod:`adhesive_contact.contact_boundary`, so z are frame components.)
+:mod:`adhesive_contact.fem.contact_boundary`, so z are frame components.)
 
 A_II is factorised once per mesh and step size by a linear backend of
 :mod:`adhesive_contact.linear_solvers`. S is read off a factorisation of

@@ -2,7 +2,7 @@
 
     Φ(z) = Σ_q w_q [P_ν(β_q, (N z)_q) + j_τ(β_q, (T z)_q)]
 
-(docs/scheme.md ('What a step solves')), with N, T the traces of :mod:`adhesive_contact.contact_boundary`
+(docs/scheme.md ('What a step solves')), with N, T the traces of :mod:`adhesive_contact.fem.contact_boundary`
 restricted to the unknowns the step solves for, β_q the P0 bonding of the
 facet holding q, and j_τ(β, ξ) = φ(β, |ξ|) radial (:mod:`adhesive_contact.laws`).
 

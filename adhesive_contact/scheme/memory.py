@@ -5,7 +5,7 @@ j = n term k R(0) ε(u_n) joins the step matrix; the rest, the history, is
 known. Because ε is linear, the history of an isotropic kernel is the
 strain of a displacement-like field, so it is stored as two nodal vectors
 (a_λ, a_μ) whose force is K_λ a_λ + K_μ a_μ and whose stress is
-tr ε(a_λ) I + 2 ε(a_μ) (see :mod:`adhesive_contact.assembly`).
+tr ε(a_λ) I + 2 ε(a_μ) (see :mod:`adhesive_contact.fem.assembly`).
 
 - Prony series R(t) = Σ_m e^{−t/τ_m} C_m (docs/model.md §4): with
   h_n^m = k Σ_{j<n} e^{−(t_n−t_j)/τ_m} u_j one has h_1^m = 0 and

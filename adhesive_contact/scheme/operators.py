@@ -1,7 +1,7 @@
 """What a run builds once per mesh and step size.
 
 The system is written in the nodal frames of Γ_C, ũ = Rᵀ u
-(:meth:`~adhesive_contact.contact_boundary.ContactBoundary.rotation`), and
+(:meth:`~adhesive_contact.fem.contact_boundary.ContactBoundary.rotation`), and
 restricted to the free dofs; the held dofs (never at Γ_C, never rotated)
 enter through the coupling block a_FD, built once per step matrix. Two step matrices serve the whole run
 (:mod:`adhesive_contact.scheme.condensed`):

@@ -53,7 +53,7 @@ class Solution:
     iterations: np.ndarray        # (M+1,) Newton iterations per step
     residual: np.ndarray          # (M+1,) final relative projected residual
     reaction: np.ndarray = None   # (M+1, nD) force of the support per held dof
-                                  # (problem.prescribed.fixed); see adhesive_contact.reactions
+                                  # (problem.prescribed.fixed); see adhesive_contact.postprocess.reactions
     timings: dict = field(default_factory=dict)
     linear: dict = field(default_factory=dict)   # the linear backend and why: {"method", "reason"}
 

@@ -28,7 +28,7 @@ class State:
     z: np.ndarray        # the step's unknowns: contact unknowns (nodal frames) or all free dofs
     u: np.ndarray        # (ndofs,) u_n, Cartesian
     frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes
-    memory: object       # the run's memory history (adhesive_contact.memory)
+    memory: object       # the run's memory history (adhesive_contact.scheme.memory)
 
 
 @dataclass
@@ -56,7 +56,7 @@ NEWTON = ("newton", "newton-plain")   # the methods that converge quadratically
 
 class ContactStep:
     """The contact terms Φ of a run's steps and the kinks of its friction
-    (:mod:`adhesive_contact.contact_energy`), solved by the scene's step
+    (:mod:`adhesive_contact.scheme.contact_energy`), solved by the scene's step
     method (:mod:`adhesive_contact.step_methods`).
 
     ``within = (positions, size)`` when the step unknowns are the free dofs
@@ -124,7 +124,7 @@ def initial_state(problem, memory, unknowns=None):
 
 def bonding_step(problem, state):
     """(4.2): β_n from β_{n−1} and u_{n−1} by the scene's integrator
-    (:mod:`adhesive_contact.bonding`); explicit Euler, the paper's, is
+    (:mod:`adhesive_contact.scheme.bonding`); explicit Euler, the paper's, is
     β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
     without a bonding law, and at n = 0)."""
     if problem.bonding is None or state.n < 0:

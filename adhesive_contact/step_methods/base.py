@@ -5,7 +5,7 @@ A step of (4.1), with the interior condensed out, minimises
 
     E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z ≤ upper  (the wall),
 
-Φ the contact terms (:class:`~adhesive_contact.contact_energy.ContactEnergy`),
+Φ the contact terms (:class:`~adhesive_contact.scheme.contact_energy.ContactEnergy`),
 whose friction adds at each node a with a kink the Clarke subdifferential
 B(0, κ_a) at ξ_a = 0. z is stationary when 0 ∈ ∂E(z) + N_wall(z): the
 *pseudo-gradient* (the minimal-norm element of that set, :func:`stationarity`)

@@ -6,7 +6,7 @@ minimises the energy of docs/scheme.md ('What a step solves') over the contact u
 
     E(z) = ½ zᵀ S z − cᵀ z + Φ(z)   subject to  z_ν ≤ g  (the wall),
 
-with Φ the contact terms (:class:`~adhesive_contact.contact_energy.ContactEnergy`).
+with Φ the contact terms (:class:`~adhesive_contact.scheme.contact_energy.ContactEnergy`).
 Friction laws with a kink at ξ = 0 (Tresca, slip weakening) add, at each
 contact node a, a term with Clarke subdifferential B(0, κ_a) at ξ_a = 0.
 

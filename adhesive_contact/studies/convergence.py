@@ -1,7 +1,7 @@
 """Convergence studies in h, k or both, kept in a folder (docs/verification.md).
 
 The computation of one level and of the fine reference is
-:mod:`adhesive_contact.convergence`; :class:`ConvergenceStudy` is the
+:mod:`adhesive_contact.verification.levels`; :class:`ConvergenceStudy` is the
 study on top of :class:`~adhesive_contact.studies.study.Study`. Its folder:
 
 - ``study.json``: the resolved scene (level 0), param, levels, reference
@@ -9,7 +9,7 @@ study on top of :class:`~adhesive_contact.studies.study.Study`. Its folder:
 - ``reference.npz`` (reference ``"fine"``): the reference run's t, u, beta,
   facets, its refine and steps and its wall time, saved once computed;
 - ``levels/level_NN.json``: one record of
-  :func:`~adhesive_contact.convergence.run_level` per finished level;
+  :func:`~adhesive_contact.verification.levels.run_level` per finished level;
 - ``errors.csv`` and ``rates.json`` (:func:`results`): rewritten from the
   saved records at the end of every completed run.
 
@@ -243,7 +243,7 @@ class ConvergenceStudy(Study):
     ref_h, ref_k : int, optional
         The fine reference has ``ref_h`` more mesh refinements and
         ``2**ref_k`` times the steps of the finest level
-        (default :func:`~adhesive_contact.convergence.default_reference_refinement`);
+        (default :func:`~adhesive_contact.verification.levels.default_reference_refinement`);
         only with ``reference="fine"``.
     refine, steps : int, optional
         Mesh refinement and steps of level 0 instead of the scene's.

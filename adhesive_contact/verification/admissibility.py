@@ -1,6 +1,6 @@
 """Is a manufactured solution a solution of the problem at all?
 
-The data of docs/verification.md (:mod:`adhesive_contact.manufactured`) make u*,
+The data of docs/verification.md (:mod:`adhesive_contact.verification.manufactured`) make u*,
 β*, λ* satisfy the equations with an extra surface load and a bonding
 source, but not the constraints: those the scene's author must get right,
 and a run that violates them converges to something else, quietly. Before

@@ -67,7 +67,7 @@ def facet_parents(meshes, coarse_facets, fine_facets):
 
     A fine boundary facet lies in one coarse facet: the one spanned by the
     coarse vertices its vertices come from
-    (:func:`~adhesive_contact.meshes.refinement_parents`), in 2D and 3D.
+    (:func:`~adhesive_contact.fem.meshes.refinement_parents`), in 2D and 3D.
     """
     parent = np.asarray(fine_facets)
     for coarse, fine in zip(meshes[-2::-1], meshes[:0:-1]):

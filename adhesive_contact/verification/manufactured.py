@@ -33,7 +33,7 @@ TOLERANCE = 1e-10
 
 def on_wall(r, g):
     """u*_ν = g up to ``TOLERANCE`` · (|u*_ν| + |g|): the contact set, where
-    the load gets λ* (and :mod:`~adhesive_contact.admissibility` checks λ* ≥ 0)."""
+    the load gets λ* (and :mod:`~adhesive_contact.verification.admissibility` checks λ* ≥ 0)."""
     return np.abs(r - g) <= TOLERANCE * (np.abs(r) + np.abs(g))
 
 _GAUSS_POINTS = 16   # Gauss–Legendre points in s for the memory integral (exact to

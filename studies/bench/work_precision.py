@@ -8,7 +8,7 @@ The scene is the manufactured case (b) of ``studies/convergence/``
 positive multiplier on half of Γ_C, an adhesive spring, Frémond bonding),
 whose friction law is smooth, so both contact quadratures apply. Each
 point is one run, a (choice, h, k) with T = 1, measured by
-:func:`adhesive_contact.convergence.run_level` against the scene's
+:func:`adhesive_contact.verification.levels.run_level` against the scene's
 ``[exact]`` solution:
 
     E = max_n (‖ε(u(t_n) − u_n^hk)‖_{L²(Ω)} + ‖β(t_n) − β_n^hk‖_{L²(Γ_C)})
