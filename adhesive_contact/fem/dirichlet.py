@@ -26,7 +26,7 @@ import scipy.sparse as sp
 
 from ..expressions import compile_expression, coordinates
 from .meshes import named_facets
-from ..scene import SceneError
+from ..scene.errors import SceneError
 
 _ZERO = compile_expression("0")
 

@@ -22,8 +22,7 @@ from .errors import SceneError
 from .parse import load_scene, parse_scene, scene_from_dict
 from .spec import (ContactSpec, ExactSpec, FoundationSpec, Isotropic, LawSpec, MemorySpec,
                    MeshSpec, PronyTerm, Scene, SolverSpec)
-from .tables import nodes_of
 
 __all__ = ["SceneError", "load_scene", "parse_scene", "scene_from_dict", "Scene", "MeshSpec",
            "Isotropic", "PronyTerm", "MemorySpec", "LawSpec", "FoundationSpec", "ContactSpec",
-           "ExactSpec", "SolverSpec", "nodes_of"]
+           "ExactSpec", "SolverSpec"]

@@ -14,10 +14,6 @@ MAX_UNIT = 16               # characters of a unit name in output.units
 #: the quantities ``output.units`` may name (labels of the plots only)
 UNIT_KEYS = ("length", "stress", "time", "force")
 
-SIDES = {2: ("left", "right", "bottom", "top"),
-         3: ("left", "right", "bottom", "top", "front", "back")}
-
-
 #: every key of a table whose reader asks for some only in some branches
 #: (a law's parameters are named by the law's reader; [mesh] and [memory]
 #: are read whole for their domain or kernel)

@@ -3,17 +3,17 @@
 solver, the outputs and a manufactured solution."""
 
 import hashlib
-import math
 from pathlib import Path
 
 from ..expressions import compile_expression
+from ..fem.meshes.builtin import SIDES, nodes_of
 from ..linear_solvers import METHODS
 from ..linear_solvers.pardiso import available as pardiso_available
 from ..step_methods import METHODS as STEP_METHODS
 from ..verification.manufactured import symbolic_problem
 from .errors import SceneError
 from .keys import (LENGTHS, LINEAR_TOL_RANGE, MAX_CELL_ASPECT, MAX_ITER, MAX_NODES,
-                   MAX_STEPS, MAX_UNIT, SIDES, TOL_RANGE, UNIT_KEYS)
+                   MAX_STEPS, MAX_UNIT, TOL_RANGE, UNIT_KEYS)
 from .reader import choice, coordinates, expression, positive, show, vector_of_expressions
 from .spec import ExactSpec, MeshSpec, SolverSpec
 
@@ -54,16 +54,6 @@ def _lengths(key, size):
         if not lo <= s <= hi:   # False for inf and nan
             raise SceneError(f"{key}[{i}]", f"must be a finite length in [{lo:g}, {hi:g}] "
                              f"(rescale the units), got {s!r}")
-
-
-def nodes_of(size_cells, refine, pattern="diagonal"):
-    """The number of nodes of the structured mesh of ``cells`` refined
-    ``refine`` times (exact, in Python integers: no overflow)."""
-    n = [c * 2**refine for c in size_cells]
-    nodes = math.prod(c + 1 for c in n)
-    if pattern == "cross":   # a centre node per quadrilateral of the unrefined mesh,
-        nodes += math.prod(size_cells) * 4**refine   # refined with the rest
-    return nodes
 
 
 def _cell_counts(key, size, cells, refine, pattern):
