@@ -4,10 +4,10 @@ laws of :mod:`adhesive_contact.laws`."""
 
 import math
 
-from ..laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
-from ..scheme.bonding import INTEGRATORS
+from ..laws import FRICTION_LAWS
 from .errors import SceneError
-from .reader import Table, choice, coordinates, expression, positive, show
+from .keys import declared
+from .reader import Table, coordinates, show, within
 from .spec import ContactSpec, FoundationSpec, LawSpec
 
 
@@ -19,19 +19,13 @@ def read_contact(table, dim, contact_sides):
         raise SceneError("contact", "a [contact] table needs boundary.contact to list its sides")
     gap = None
     if table.has("gap"):
-        source = table.get("gap", "expr")
-        gap = expression(table.key("gap"), source, coordinates(dim) + ("t",))
-        if gap.is_constant and float(gap(0.0)) < 0:
-            raise SceneError(table.key("gap"), f"must be >= 0, got {source}")
+        gap = table.read_expression("gap", coordinates(dim) + ("t",))
     foundation = _read_foundation(table.table("foundation"), dim)
     if gap is not None and foundation is not None:
         raise SceneError(table.key("foundation"), "give exactly one of contact.gap (an "
                          "expression) and [contact.foundation] (a geometry)")
-    quadrature = choice(table.key("quadrature"),
-                         table.get("quadrature", "str", "nodal"), ("nodal", "gauss"))
-    order = table.get("order", "int", 4, required=False)
-    if not 1 <= order <= 10:
-        raise SceneError(table.key("order"), f"must be an integer in 1..10, got {order}")
+    quadrature = table.read("quadrature")
+    order = table.read("order")
     normal = _read_normal(table.table("normal"))
     friction = _read_friction(table)
     bonding, beta0, integrator = _read_bonding(table.table("bonding"), dim)
@@ -50,7 +44,7 @@ def _read_normal(table):
     """The normal law of ``contact.normal`` (law "none" without the table)."""
     if table is None:
         return LawSpec("none")
-    normal = _law(table, NORMAL_LAWS)
+    normal = _law(table)
     table.finish()
     return normal
 
@@ -66,7 +60,7 @@ def _read_friction(table):
     for i, item in enumerate(items):
         key = table.key("friction") + (f"[{i}]" if isinstance(raw, list) else "")
         sub = Table(item, key)
-        spec = _law(sub, FRICTION_LAWS)
+        spec = _law(sub)
         sub.finish()
         if spec.law != "none":
             laws.append(spec)
@@ -77,30 +71,23 @@ def _read_bonding(table, dim):
     """(bonding law, β_0 or None, integrator) of ``contact.bonding``."""
     if table is None:
         return LawSpec("none"), None, ContactSpec.integrator
-    bonding = _law(table, BONDING_LAWS)
+    bonding = _law(table)
     beta0 = None
-    if table.has("beta0"):
-        source = table.get("beta0", "expr")
-        beta0 = expression(table.key("beta0"), source, coordinates(dim))
-        if beta0.is_constant and not 0.0 <= float(beta0(0.0)) <= 1.0:
-            raise SceneError(table.key("beta0"), f"must lie in [0, 1], got {source}")
-    integrator = choice(table.key("integrator"),
-                         table.get("integrator", "str", "explicit"), tuple(INTEGRATORS))
+    if table.has("beta0"):   # absent: None, β_0 at its default 1
+        beta0 = table.read_expression("beta0", coordinates(dim))
+    integrator = table.read("integrator")
     table.finish()
     return bonding, beta0, integrator
 
 
-def _law(table, registry):
-    """A LawSpec of ``registry`` (law name -> (class, {parameter: constraint}))."""
-    name = choice(table.key("law"), table.get("law", "str"), tuple(registry))
+def _law(table):
+    """A LawSpec of the registry the table's law key names (law name ->
+    (class, {parameter: "positive" or "nonnegative"}))."""
+    name = table.read("law")
+    registry = declared(table.key("law")).laws
     params = {}
     for pname, constraint in registry[name][1].items():
-        value = table.get(pname, "number")
-        if constraint == "positive":
-            positive(table.key(pname), value)
-        elif constraint == "nonnegative" and value < 0:
-            raise SceneError(table.key(pname), f"must be >= 0, got {value:g}")
-        params[pname] = value
+        params[pname] = within(table.key(pname), table.get(pname, "number"), constraint)
     check = getattr(registry[name][0], "check", None)
     problem = check(params) if check else None
     if problem:
@@ -109,7 +96,7 @@ def _law(table, registry):
 
 
 def _point(table, name, dim, nonzero=False):
-    value = table.get(name, "list")
+    value = table.read(name)
     if len(value) != dim or not all(isinstance(c, (int, float)) and not isinstance(c, bool)
                                     and math.isfinite(c) for c in value):
         raise SceneError(table.key(name), f"must be a list of {dim} numbers, got {show(value)}")
@@ -122,14 +109,13 @@ def _read_foundation(table, dim):
     """A FoundationSpec of ``contact.foundation``, or None without the table."""
     if table is None:
         return None
-    shapes = ("plane", "sphere") if dim == 2 else ("plane", "sphere", "cylinder")
-    shape = choice(table.key("shape"), table.get("shape", "str", "plane"), shapes)
+    shape = table.read("shape", dim)
     point = _point(table, "point", dim)
     normal = axis = radius = None
     if shape == "plane":
         normal = _point(table, "normal", dim, nonzero=True)
     else:
-        radius = positive(table.key("radius"), table.get("radius", "number"))
+        radius = table.read("radius")
     if shape == "cylinder":
         axis = _point(table, "axis", dim, nonzero=True)
     table.finish()

@@ -2,7 +2,7 @@
 by a Young or a Lamé pair, and the memory kernels built of them."""
 
 from .errors import SceneError
-from .reader import Table, choice, expression, positive
+from .reader import Table
 from .spec import Isotropic, MemorySpec, PronyTerm
 
 
@@ -13,16 +13,14 @@ def _isotropic(table, dim):
     if young and lame:
         raise SceneError(table.key("E"), "give exactly one pair: E and nu, or lam and mu")
     if lame:
-        lam = table.get("lam", "number")
-        mu = positive(table.key("mu"), table.get("mu", "number"))
+        lam = table.read("lam")
+        mu = table.read("mu")
         if not lam + 2.0 * mu / dim > 0:
             raise SceneError(table.key("lam"),
                              f"must give a positive bulk modulus lam + 2 mu/{dim} > 0")
         return Isotropic(lam, mu)
-    E = positive(table.key("E"), table.get("E", "number"))
-    nu = table.get("nu", "number")
-    if not -1.0 < nu < 0.5:
-        raise SceneError(table.key("nu"), f"must lie in (-1, 0.5), got {nu:g}")
+    E = table.read("E")
+    nu = table.read("nu")
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     mu = E / (2.0 * (1.0 + nu))
     return Isotropic(lam, mu, E, nu)
@@ -38,20 +36,19 @@ def read_memory(table, dim):
     """A MemorySpec, or None without a [memory] table."""
     if table is None:
         return None
-    kernel = choice(table.key("kernel"), table.get("kernel", "str"),
-                     ("prony", "function", "relaxation"))
+    kernel = table.read("kernel")
     if kernel == "function":
-        function = expression(table.key("r"), table.get("r", "expr"), ("t",))
+        function = table.read_expression("r", ("t",))
         tensor = _isotropic(table, dim)
         table.finish()
         return MemorySpec("function", function=function, tensor=tensor)
     long_term = None
     if kernel == "relaxation":
-        raw = table.get("long_term", "table")
+        raw = table.read("long_term")
         lt = Table(raw, table.key("long_term"))
         long_term = _isotropic(lt, dim)
         lt.finish()
-    terms_raw = table.get("terms", "list")
+    terms_raw = table.read("terms")
     if not terms_raw:
         raise SceneError(table.key("terms"), "must list at least one term {E, nu, tau}")
     terms = []
@@ -61,7 +58,7 @@ def read_memory(table, dim):
                 and not t.has("nu") and not (t.has("lam") or t.has("mu")):
             t.data = {**t.data, "nu": long_term.nu}   # nu defaults to long_term's
         tensor = _isotropic(t, dim)
-        tau = positive(t.key("tau"), t.get("tau", "number"))
+        tau = t.read("tau")
         t.finish()
         terms.append(PronyTerm(tensor, tau))
     table.finish()

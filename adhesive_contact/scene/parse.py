@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .contact import read_contact
 from .errors import SceneError
-from .keys import MAX_TITLE
+from .keys import MAX_TITLE, declared
 from .materials import check_relaxation_step, instantaneous, read_material, read_memory
 from .reader import Table
 from .spec import Scene
@@ -26,16 +26,16 @@ def scene_from_dict(data, base_dir=None):
     ``base_dir`` is the folder a relative ``mesh.file`` is taken in
     (default: the working directory)."""
     top = Table(data, "")
-    title = top.get("title", "str", "untitled", required=False)
+    title = top.read("title")
     if len(title) > MAX_TITLE:
         raise SceneError("title", f"must have at most {MAX_TITLE} characters, got {len(title)}")
-    dim = top.get("dim", "int")
-    if dim not in (2, 3):
+    dim = top.get("dim", "int")   # its choices with a message of their own
+    if dim not in declared("dim").choices:
         raise SceneError("dim", f"must be 2 (plane strain) or 3, got {dim}")
-    mesh = read_mesh(top.table("mesh", required=True), dim, base_dir)
+    mesh = read_mesh(top.table("mesh"), dim, base_dir)
     by_file = mesh.domain == "file"
     dirichlet, contact_sides, displacement = read_boundary(
-        top.table("boundary", required=True), dim, by_file)
+        top.table("boundary"), dim, by_file)
     memory = read_memory(top.table("memory"), dim)
     if memory is not None and memory.kernel == "relaxation":
         if top.has("material"):
@@ -44,10 +44,10 @@ def scene_from_dict(data, base_dir=None):
         top.used.add("material")
         material = instantaneous(memory)
     else:
-        material = read_material(top.table("material", required=True), dim)
+        material = read_material(top.table("material"), dim)
     body, traction = read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)
     contact = read_contact(top.table("contact"), dim, contact_sides)
-    T, steps = read_time(top.table("time", required=True))
+    T, steps = read_time(top.table("time"))
     solver = read_solver(top.table("solver"))
     probes, units = read_output(top.table("output"), dim)
     exact = read_exact(top.table("exact"), dim, contact, top.has("loads"))

@@ -8,7 +8,8 @@ so that the studies of earlier scenes keep their identity.
 
 from pathlib import Path
 
-from .spec import ContactSpec, SolverSpec
+from .keys import default
+from .spec import ContactSpec
 
 
 def resolved(scene):
@@ -99,7 +100,8 @@ def _contact_record(contact):
 def _solver_record(solver):
     record = {"method": solver.method, "tol": solver.tol, "max_iter": solver.max_iter,
               "linear": solver.linear}
-    if solver.linear_tol != SolverSpec.linear_tol:   # recorded when set: study identities keep
+    # recorded only when set: the studies made before the key existed keep their identity
+    if solver.linear_tol != default("solver.linear_tol"):
         record["linear_tol"] = solver.linear_tol
     if solver.method == "penalty":
         record.update(penalty=solver.penalty, smoothing=solver.smoothing)

@@ -12,6 +12,8 @@ defaults when absent.
 
 from dataclasses import dataclass, field
 
+from .keys import default
+
 
 @dataclass(frozen=True)
 class MeshSpec:
@@ -27,8 +29,8 @@ class MeshSpec:
     domain: str
     size: tuple = ()
     cells: tuple = ()
-    pattern: str = "diagonal"
-    refine: int = 0
+    pattern: str = default("mesh.pattern")
+    refine: int = default("mesh.refine")
     file: str = None
     path: str = None
     sha256: str = None
@@ -123,13 +125,13 @@ class ContactSpec:
     """
 
     gap: object = None            # Expression, or None for no wall
-    quadrature: str = "nodal"
-    order: int = 4                # exactness of the Gauss rule on Γ_C
+    quadrature: str = default("contact.quadrature")
+    order: int = default("contact.order")   # exactness of the Gauss rule on Γ_C
     normal: LawSpec = LawSpec("none")
     friction: tuple = ()          # LawSpecs whose potentials sum
     bonding: LawSpec = LawSpec("none")
     beta0: object = None          # Expression for β_0, or None for β_0 = 1
-    integrator: str = "explicit"  # for the bonding ODE
+    integrator: str = default("contact.bonding.integrator")   # for the bonding ODE
     foundation: FoundationSpec = None  # the wall's geometry, instead of a gap expression
 
     @property
@@ -168,13 +170,13 @@ class SolverSpec:
     of the body.
     """
 
-    method: str = "newton"
-    tol: float = 1e-10
-    max_iter: int = 50
-    linear: str = "auto"          # the linear backend (adhesive_contact.linear_solvers)
-    penalty: float = 1e4          # relative to max diag S
-    smoothing: float = 1e-6       # relative to the diameter of the body
-    linear_tol: float = 1e-10     # AMG's CG: relative residual of each linear solve
+    method: str = default("solver.method")
+    tol: float = default("solver.tol")
+    max_iter: int = default("solver.max_iter")
+    linear: str = default("solver.linear")   # the backend (adhesive_contact.linear_solvers)
+    penalty: float = default("solver.penalty")       # relative to max diag S
+    smoothing: float = default("solver.smoothing")   # relative to the diameter of the body
+    linear_tol: float = default("solver.linear_tol")   # AMG's CG: of each linear solve
 
 
 @dataclass(frozen=True)

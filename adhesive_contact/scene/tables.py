@@ -7,53 +7,45 @@ from pathlib import Path
 
 from ..expressions import compile_expression
 from ..fem.meshes.builtin import SIDES, nodes_of
-from ..linear_solvers import METHODS
 from ..linear_solvers.pardiso import available as pardiso_available
-from ..step_methods import METHODS as STEP_METHODS
 from ..verification.manufactured import symbolic_problem
 from .errors import SceneError
-from .keys import (LENGTHS, LINEAR_TOL_RANGE, MAX_CELL_ASPECT, MAX_ITER, MAX_NODES,
-                   MAX_STEPS, MAX_UNIT, TOL_RANGE, UNIT_KEYS)
-from .reader import choice, coordinates, expression, positive, show, vector_of_expressions
+from .keys import MAX_CELL_ASPECT, MAX_NODES, MAX_UNIT, declared, keys_in
+from .reader import coordinates, expression, show, vector_of_expressions
 from .spec import ExactSpec, MeshSpec, SolverSpec
 
 
 def read_mesh(table, dim, base_dir):
-    domains = {2: ("rectangle", "file"), 3: ("box", "file")}[dim]
-    domain = choice(table.key("domain"), table.get("domain", "str"), domains)
-    refine = table.get("refine", "int", 0, required=False)
-    if refine < 0 or refine > 12:
-        raise SceneError(table.key("refine"), f"must be an integer in 0..12, got {refine}")
+    domain = table.read("domain", dim)
+    refine = table.read("refine")
     if domain == "file":
         return _read_mesh_file(table, dim, base_dir, refine)
-    size = table.get("size", "list")
+    size = table.read("size")
     if len(size) != dim or not all(isinstance(s, (int, float)) and not isinstance(s, bool)
                                    and s > 0 for s in size):
         raise SceneError(table.key("size"), f"must be a list of {dim} positive lengths, "
                          f"got {show(size)}")
-    _lengths(table.key("size"), size)
-    cells = table.get("cells", "list")
+    _lengths(table.key("size"), size, declared(table.key("size")).bounds)
+    cells = table.read("cells")
     if len(cells) != dim or not all(isinstance(c, int) and not isinstance(c, bool)
                                     and c >= 1 for c in cells):
         raise SceneError(table.key("cells"), f"must be a list of {dim} integers >= 1, "
                          f"got {show(cells)}")
-    patterns = ("diagonal", "cross") if dim == 2 else ("diagonal",)
-    pattern = choice(table.key("pattern"), table.get("pattern", "str", "diagonal"), patterns)
+    pattern = table.read("pattern", dim)
     _cell_counts(table.key("cells"), size, cells, refine, pattern)
     table.finish()
     return MeshSpec(domain, tuple(float(s) for s in size), tuple(cells), pattern, refine,
                     dim=dim)
 
 
-def _lengths(key, size):
-    """Each length finite and within LENGTHS: outside, the element volumes
-    (h^d, refined up to 4096 times) underflow or the stiffness overflows,
-    and the factorisation meets zero pivots."""
-    lo, hi = LENGTHS
+def _lengths(key, size, lengths):
+    """Each length finite and within the interval ``lengths``: outside, the
+    element volumes (h^d, refined up to 4096 times) underflow or the
+    stiffness overflows, and the factorisation meets zero pivots."""
     for i, s in enumerate(size):
-        if not lo <= s <= hi:   # False for inf and nan
-            raise SceneError(f"{key}[{i}]", f"must be a finite length in [{lo:g}, {hi:g}] "
-                             f"(rescale the units), got {s!r}")
+        if s not in lengths:   # False for inf and nan
+            raise SceneError(f"{key}[{i}]", f"must be a finite length in [{lengths.lo:g}, "
+                             f"{lengths.hi:g}] (rescale the units), got {s!r}")
 
 
 def _cell_counts(key, size, cells, refine, pattern):
@@ -76,7 +68,7 @@ def _read_mesh_file(table, dim, base_dir, refine):
     """A file mesh: ``file`` is relative to ``base_dir`` (the scene file's
     folder; the working directory when None). Its content is hashed here;
     it is read when the problem is built."""
-    given = table.get("file", "str")
+    given = table.read("file")
     table.finish()
     path = Path(given).expanduser()
     if not path.is_absolute():
@@ -120,7 +112,7 @@ def read_boundary(table, dim, named_by_file=False):
 def _read_sides(table, name, dim, named_by_file):
     """The sides listed under ``name``: built-in side names, or (for a file
     mesh) any names, checked against the file's groups when the mesh is built."""
-    value = table.get(name, "list", [], required=False)
+    value = table.read(name)
     sides = SIDES[dim]
     for i, side in enumerate(value):
         if named_by_file and not isinstance(side, str):
@@ -188,8 +180,7 @@ def read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
         return body, traction
     variables = coordinates(dim) + ("t",)
     if table.has("body"):
-        body = vector_of_expressions(table.key("body"), table.get("body", "list"), dim,
-                                      variables)
+        body = vector_of_expressions(table.key("body"), table.read("body"), dim, variables)
     tt = table.table("traction")
     if tt is not None:
         for side, raw in tt.data.items():
@@ -209,49 +200,27 @@ def read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
 
 def read_time(table):
     """(T, steps)."""
-    T = positive("time.T", table.get("T", "number"))
-    steps = table.get("steps", "int")
-    if not 1 <= steps <= MAX_STEPS:
-        raise SceneError("time.steps", f"must be an integer in 1..{MAX_STEPS:.0e}, got {steps}")
+    T = table.read("T")
+    steps = table.read("steps")
     table.finish()
     return T, steps
-
-
-def _tolerance(key, tol):
-    """tol within TOL_RANGE: the residual is relative to the step's force
-    scale, so a tol near 1 accepts the starting point as the solution (no
-    Newton iteration, a quiet wrong answer), and below 1e-14 round-off
-    keeps the residual from reaching it."""
-    lo, hi = TOL_RANGE
-    if not lo <= tol <= hi:
-        raise SceneError(key, f"must lie in [{lo:g}, {hi:g}], got {tol:g}: it is relative to "
-                         "the force scale of a step, so a larger tol accepts the start as the "
-                         "solution and a smaller one is below round-off")
-    return tol
 
 
 def read_solver(table):
     """A SolverSpec; ``SolverSpec()`` without a [solver] table."""
     if table is None:
         return SolverSpec()
-    method = choice("solver.method", table.get("method", "str", "newton"), tuple(STEP_METHODS))
-    tol = _tolerance("solver.tol", table.get("tol", "number", 1e-10))
-    max_iter = table.get("max_iter", "int", 50)
-    if not 1 <= max_iter <= MAX_ITER:
-        raise SceneError("solver.max_iter", f"must be an integer in 1..{MAX_ITER}, "
-                         f"got {max_iter}")
-    linear = choice("solver.linear", table.get("linear", "str", "auto"), METHODS)
+    method = table.read("method")
+    tol = table.read("tol")
+    max_iter = table.read("max_iter")
+    linear = table.read("linear")
     if linear == "pardiso" and not pardiso_available():
+        others = ", ".join(m for m in declared("solver.linear").choices if m != "pardiso")
         raise SceneError("solver.linear", "'pardiso' needs pypardiso and MKL, which are not "
-                         "installed here; allowed are auto, superlu, amg")
-    penalty = positive("solver.penalty", table.get("penalty", "number", SolverSpec.penalty))
-    smoothing = positive("solver.smoothing",
-                          table.get("smoothing", "number", SolverSpec.smoothing))
-    linear_tol = table.get("linear_tol", "number", SolverSpec.linear_tol)
-    lo, hi = LINEAR_TOL_RANGE
-    if not lo <= linear_tol <= hi:
-        raise SceneError("solver.linear_tol", f"must lie in [{lo:g}, {hi:g}], got "
-                         f"{linear_tol:g}: the relative residual of each iterative linear solve")
+                         f"installed here; allowed are {others}")
+    penalty = table.read("penalty")
+    smoothing = table.read("smoothing")
+    linear_tol = table.read("linear_tol")
     table.finish()
     return SolverSpec(method, tol, max_iter, linear, penalty, smoothing, linear_tol)
 
@@ -270,11 +239,11 @@ def _read_units(table):
     if table is None:
         return {}
     units = {}
-    for name in UNIT_KEYS:
+    for name in keys_in("output.units"):
         if not table.has(name):
             table.used.add(name)
             continue
-        value = table.get(name, "str")
+        value = table.read(name)
         if not 1 <= len(value) <= MAX_UNIT or not value.isprintable() or value != value.strip():
             raise SceneError(table.key(name), f"must be a unit name of 1 to {MAX_UNIT} "
                              f"printable characters without outer spaces, got {show(value)}")
@@ -285,7 +254,7 @@ def _read_units(table):
 
 def _read_probes(table, dim):
     """The probe points of ``output.probes``."""
-    raw = table.get("probes", "list", [], required=False)
+    raw = table.read("probes")
     for i, p in enumerate(raw):
         if not (isinstance(p, list) and len(p) == dim and all(
                 isinstance(c, (int, float)) and not isinstance(c, bool) for c in p)):
@@ -304,15 +273,15 @@ def read_exact(table, dim, contact, has_loads):
         raise SceneError("loads", "a scene with [exact] derives its loads from the exact "
                          "solution; remove [loads]")
     variables = coordinates(dim) + ("t",)
-    u = vector_of_expressions("exact.u", table.get("u", "list"), dim, variables)
+    u = vector_of_expressions("exact.u", table.read("u"), dim, variables)
     beta = multiplier = None
     if table.has("beta"):
-        beta = expression("exact.beta", table.get("beta", "expr"), variables)
+        beta = table.read_expression("beta", variables)
         if beta.depends_on_time and contact.bonding.law == "none":
             raise SceneError("exact.beta", "depends on t, but contact.bonding.law is "
                              "'none' (β frozen); use a bonding law")
     if table.has("multiplier"):
-        multiplier = expression("exact.multiplier", table.get("multiplier", "expr"), variables)
+        multiplier = table.read_expression("multiplier", variables)
         if contact.foundation is not None:
             raise SceneError("exact.multiplier", "a manufactured wall needs contact.gap as "
                              "an expression, not [contact.foundation]")
