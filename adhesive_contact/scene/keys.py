@@ -119,7 +119,7 @@ def _pair(table, tensor):
     )
 
 
-#: the limits of a scene that are not the bounds of one key
+#: the limits the readers check in their own words (a length of text, a count of nodes)
 MAX_TITLE = 500             # characters of the title (it heads every plot)
 MAX_CELL_ASPECT = 1e3       # longest over shortest edge of the structured cells
 MAX_NODES = 10**8           # nodes of the refined mesh
