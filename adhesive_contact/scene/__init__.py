@@ -11,7 +11,8 @@ line that names the key and says what is allowed.
 - :mod:`.spec`: the dataclasses of a validated scene, :class:`Scene` and
   one per table;
 - :mod:`.record`: the resolved record (:attr:`Scene.resolved`);
-- :mod:`.keys`: the limits and the keys of each table;
+- :mod:`.keys`: every key declared once (kind, default, choices, bounds,
+  meaning);
 - :mod:`.reader`: typed access to a TOML table and the checks the table
   readers share;
 - :mod:`.tables`, :mod:`.materials`, :mod:`.contact`: the table readers;
