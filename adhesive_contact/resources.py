@@ -37,8 +37,9 @@ import os
 import shutil
 from dataclasses import asdict, dataclass
 
+from .fem.meshes.builtin import nodes_of
 from .linear_solvers import choose, factor_bytes
-from .scene import SceneError, nodes_of
+from .scene import SceneError
 from .scheme.operators import FULL_SYSTEM
 
 #: stored entries per node of a P1 stiffness row block, per component pair

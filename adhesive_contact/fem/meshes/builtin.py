@@ -7,8 +7,12 @@ centre (``"cross"``); a box [0, L_x] × [0, L_y] × [0, L_z] into tetrahedra.
 so meshes of one scene at different ``refine`` are nested.
 
 Sides are named as scikit-fem does: left/right (x = 0, L_x), bottom/top
-(y = 0, L_y) and, in 3D, front/back (z = 0, L_z).
+(y = 0, L_y) and, in 3D, front/back (z = 0, L_z) (:data:`SIDES`, the
+names a scene may use with these domains). :func:`nodes_of` counts the
+nodes of a mesh before it is built.
 """
+
+import math
 
 import numpy as np
 from skfem import MeshQuad, MeshTet, MeshTri
@@ -31,6 +35,16 @@ def side_tests(size):
         tests[low] = lambda x, a=axis: np.abs(x[a]) < tol
         tests[high] = lambda x, a=axis, L=length: np.abs(x[a] - L) < tol
     return tests
+
+
+def nodes_of(size_cells, refine, pattern="diagonal"):
+    """The number of nodes of the structured mesh of ``cells`` refined
+    ``refine`` times (exact, in Python integers: no overflow)."""
+    n = [c * 2**refine for c in size_cells]
+    nodes = math.prod(c + 1 for c in n)
+    if pattern == "cross":   # a centre node per quadrilateral of the unrefined mesh,
+        nodes += math.prod(size_cells) * 4**refine   # refined with the rest
+    return nodes
 
 
 def structured_mesh(spec):

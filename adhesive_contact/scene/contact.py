@@ -1,0 +1,122 @@
+"""The readers of ``[contact]``: the wall (a gap expression or a
+foundation), the quadrature on Γ_C, and the normal, friction and bonding
+laws of :mod:`adhesive_contact.laws`."""
+
+import math
+
+from ..laws import FRICTION_LAWS
+from .errors import SceneError
+from .keys import declared
+from .reader import Table, coordinates, show, within
+from .spec import ContactSpec, FoundationSpec, LawSpec
+
+
+def read_contact(table, dim, contact_sides):
+    """A ContactSpec; ``ContactSpec()`` without a [contact] table."""
+    if table is None:
+        return ContactSpec()
+    if not contact_sides:
+        raise SceneError("contact", "a [contact] table needs boundary.contact to list its sides")
+    gap = None
+    if table.has("gap"):
+        gap = table.read_expression("gap", coordinates(dim) + ("t",))
+    foundation = _read_foundation(table.table("foundation"), dim)
+    if gap is not None and foundation is not None:
+        raise SceneError(table.key("foundation"), "give exactly one of contact.gap (an "
+                         "expression) and [contact.foundation] (a geometry)")
+    quadrature = table.read("quadrature")
+    order = table.read("order")
+    normal = _read_normal(table.table("normal"))
+    friction = _read_friction(table)
+    bonding, beta0, integrator = _read_bonding(table.table("bonding"), dim)
+    table.finish()
+    kinked = [f.law for f in friction if FRICTION_LAWS[f.law][0].has_kink]
+    if quadrature == "gauss" and kinked:
+        smooth = ", ".join(name for name, (cls, _) in FRICTION_LAWS.items()
+                           if cls is not None and not cls.has_kink)
+        raise SceneError(table.key("quadrature"), f"'gauss' takes smooth friction laws only "
+                         f"({smooth}); {kinked[0]!r} needs 'nodal'")
+    return ContactSpec(gap, quadrature, order, normal, friction, bonding, beta0, integrator,
+                       foundation)
+
+
+def _read_normal(table):
+    """The normal law of ``contact.normal`` (law "none" without the table)."""
+    if table is None:
+        return LawSpec("none")
+    normal = _law(table)
+    table.finish()
+    return normal
+
+
+def _read_friction(table):
+    """The friction laws of ``contact.friction``: one table or a list of them."""
+    raw = table.data.get("friction")
+    table.used.add("friction")
+    if raw is None:
+        return ()
+    items = raw if isinstance(raw, list) else [raw]
+    laws = []
+    for i, item in enumerate(items):
+        key = table.key("friction") + (f"[{i}]" if isinstance(raw, list) else "")
+        sub = Table(item, key)
+        spec = _law(sub)
+        sub.finish()
+        if spec.law != "none":
+            laws.append(spec)
+    return tuple(laws)
+
+
+def _read_bonding(table, dim):
+    """(bonding law, β_0 or None, integrator) of ``contact.bonding``."""
+    if table is None:
+        return LawSpec("none"), None, ContactSpec.integrator
+    bonding = _law(table)
+    beta0 = None
+    if table.has("beta0"):   # absent: None, β_0 at its default 1
+        beta0 = table.read_expression("beta0", coordinates(dim))
+    integrator = table.read("integrator")
+    table.finish()
+    return bonding, beta0, integrator
+
+
+def _law(table):
+    """A LawSpec of the registry the table's law key names (law name ->
+    (class, {parameter: "positive" or "nonnegative"}))."""
+    name = table.read("law")
+    registry = declared(table.key("law")).laws
+    params = {}
+    for pname, constraint in registry[name][1].items():
+        params[pname] = within(table.key(pname), table.get(pname, "number"), constraint)
+    check = getattr(registry[name][0], "check", None)
+    problem = check(params) if check else None
+    if problem:
+        raise SceneError(table.key(problem[0]), problem[1])
+    return LawSpec(name, params)
+
+
+def _point(table, name, dim, nonzero=False):
+    value = table.read(name)
+    if len(value) != dim or not all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                    and math.isfinite(c) for c in value):
+        raise SceneError(table.key(name), f"must be a list of {dim} numbers, got {show(value)}")
+    if nonzero and not any(value):
+        raise SceneError(table.key(name), "must be a nonzero vector")
+    return tuple(float(c) for c in value)
+
+
+def _read_foundation(table, dim):
+    """A FoundationSpec of ``contact.foundation``, or None without the table."""
+    if table is None:
+        return None
+    shape = table.read("shape", dim)
+    point = _point(table, "point", dim)
+    normal = axis = radius = None
+    if shape == "plane":
+        normal = _point(table, "normal", dim, nonzero=True)
+    else:
+        radius = table.read("radius")
+    if shape == "cylinder":
+        axis = _point(table, "axis", dim, nonzero=True)
+    table.finish()
+    return FoundationSpec(shape, point, normal, axis, radius)

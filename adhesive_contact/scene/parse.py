@@ -1,0 +1,78 @@
+"""A scene from a file, a TOML document or the dictionary it decodes to.
+
+``base_dir`` is where a relative ``mesh.file`` is found. Every key is
+checked: a missing, unknown or wrongly typed key, or a value outside its
+range, raises :class:`~.errors.SceneError` whose message is one line that
+names the key and says what is allowed. Nothing is computed here;
+geometry-dependent checks (a probe outside the mesh, a negative gap, side
+names that a mesh file does not have) are made when the problem is built.
+"""
+
+import tomllib
+from pathlib import Path
+
+from .contact import read_contact
+from .errors import SceneError
+from .keys import MAX_TITLE, declared
+from .materials import check_relaxation_step, instantaneous, read_material, read_memory
+from .reader import Table
+from .spec import Scene
+from .tables import (read_boundary, read_exact, read_loads, read_mesh, read_output,
+                     read_solver, read_time)
+
+
+def scene_from_dict(data, base_dir=None):
+    """Validate a decoded scene document and return a :class:`Scene`;
+    ``base_dir`` is the folder a relative ``mesh.file`` is taken in
+    (default: the working directory)."""
+    top = Table(data, "")
+    title = top.read("title")
+    if len(title) > MAX_TITLE:
+        raise SceneError("title", f"must have at most {MAX_TITLE} characters, got {len(title)}")
+    dim = top.get("dim", "int")   # its choices with a message of their own
+    if dim not in declared("dim").choices:
+        raise SceneError("dim", f"must be 2 (plane strain) or 3, got {dim}")
+    mesh = read_mesh(top.table("mesh"), dim, base_dir)
+    by_file = mesh.domain == "file"
+    dirichlet, contact_sides, displacement = read_boundary(
+        top.table("boundary"), dim, by_file)
+    memory = read_memory(top.table("memory"), dim)
+    if memory is not None and memory.kernel == "relaxation":
+        if top.has("material"):
+            raise SceneError("material", "a relaxation kernel ([memory] kernel = "
+                             "\"relaxation\") gives the material; remove [material]")
+        top.used.add("material")
+        material = instantaneous(memory)
+    else:
+        material = read_material(top.table("material"), dim)
+    body, traction = read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)
+    contact = read_contact(top.table("contact"), dim, contact_sides)
+    T, steps = read_time(top.table("time"))
+    solver = read_solver(top.table("solver"))
+    probes, units = read_output(top.table("output"), dim)
+    exact = read_exact(top.table("exact"), dim, contact, top.has("loads"))
+    top.finish()
+    if memory is not None and memory.kernel == "relaxation":
+        check_relaxation_step(memory, dim, T / steps)
+    return Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
+                 traction, contact, T, steps, solver, probes, exact, displacement, units)
+
+
+def parse_scene(text, base_dir=None):
+    """Parse a TOML scene document; TOML syntax errors become SceneError.
+    ``base_dir``: the folder a relative ``mesh.file`` is taken in."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError("", f"not valid TOML: {err}") from None
+    except RecursionError:
+        raise SceneError("", "not a usable TOML document: arrays or tables nested too "
+                         "deeply") from None
+    return scene_from_dict(data, base_dir)
+
+
+def load_scene(path):
+    """Read and parse the scene file ``path``; a relative ``mesh.file`` is
+    taken in the scene file's folder. OSError if the file cannot be read."""
+    path = Path(path)
+    return parse_scene(path.read_text(encoding="utf-8"), base_dir=path.parent)
