@@ -13,11 +13,12 @@ from pathlib import Path
 import click
 
 from adhesive_contact import SceneError, scene_from_dict
+from adhesive_contact.storage import toml_value
 from adhesive_contact.studies import (
     Sweep,
     parse_assignment,
 )
-from adhesive_contact.studies.sweep import LOST, show, variant_document, variants
+from adhesive_contact.studies.sweep import LOST, variant_document, variants
 from adhesive_contact.visuals import write_sweep_plots
 
 from .common import (
@@ -41,7 +42,7 @@ def table(rows, keys):
     """One line per run: its settings, outcome, time, iterations, β and force at T."""
     lines = []
     for row in rows:
-        settings = ", ".join(f"{k}={show(row[k])}" for k in keys)
+        settings = ", ".join(f"{k}={toml_value(row[k])}" for k in keys)
         if row["outcome"] == "ok":
             result = (f"ok, {row['newton_total']} Newton its, β mean "
                       f"{_fmt(row['beta_mean_T'], '.4g')}, normal force "
@@ -68,7 +69,7 @@ def guard_variants(source, settings, grid, force):
             scene = scene_from_dict(variant_document(source, values))
         except (SceneError, ValueError):
             continue   # the sweep names the setting at fault
-        where = ", ".join(f"{k}={show(v)}" for k, v in values.items())
+        where = ", ".join(f"{k}={toml_value(v)}" for k, v in values.items())
         guard(scene, what=f"the variant {where}")
 
 

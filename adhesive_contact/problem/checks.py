@@ -34,7 +34,7 @@ import numpy as np
 
 from ..expressions import coordinates
 from ..fem.dirichlet import rigid_modes
-from ..scene import SceneError
+from ..scene.errors import SceneError, where
 
 #: time levels sampled besides t = 0 and t = T
 TIME_SAMPLES = 16
@@ -47,17 +47,6 @@ def sample_times(times, count=TIME_SAMPLES):
     n = times.size - 1
     picks = np.unique(np.round(np.linspace(0, n, min(n + 1, count + 2))).astype(np.int64))
     return times[picks]
-
-
-def where(points, index=None, t=None, digits=6):
-    """A point of a message: "(x, y)", or "(x, y), t = t" with a time.
-
-    ``points`` is (d,) or (d, n) with ``index`` naming the column; each
-    coordinate to ``digits`` significant digits."""
-    points = np.asarray(points)
-    x = points if index is None else points[:, index]
-    text = "(" + ", ".join(f"{c:.{digits}g}" for c in x) + ")"
-    return text if t is None else f"{text}, t = {t:g}"
 
 
 def check_values(key, values, points, t, what="is not finite"):

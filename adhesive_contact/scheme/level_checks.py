@@ -22,7 +22,7 @@ says what failed, where, the figures and what to try.
 
 import numpy as np
 
-from ..problem.checks import where
+from ..scene.errors import where
 from ..step_methods import EXACT
 from .solution import StepFailure
 

@@ -31,7 +31,6 @@ From Python::
 import copy
 import csv
 import itertools
-import json
 import re
 import resource
 import time
@@ -41,7 +40,7 @@ from dataclasses import dataclass
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.quantities import beta_mean
 from ..postprocess.states import contact_state_counts
-from ..storage import plain, write_atomic
+from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 
 MODES = ("grid", "zip")
@@ -57,17 +56,6 @@ _BARE = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
 
 # ---------------------------------------------------------------- settings
-
-
-def show(value):
-    """A value as it is written in TOML (``1000.0``, ``true``, ``"gauss"``)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list):
-        return "[" + ", ".join(show(v) for v in value) + "]"
-    return repr(value)
 
 
 def split_values(text):
@@ -375,8 +363,8 @@ class Sweep(Study):
         except SceneError as err:
             if err.key in values:
                 reason = str(err).removeprefix(f"{err.key}: ")
-                raise StudyError(f"set {err.key}={show(values[err.key])}", reason) from None
-            where = ", ".join(f"{k}={show(v)}" for k, v in values.items())
+                raise StudyError(f"set {err.key}={toml_value(values[err.key])}", reason) from None
+            where = ", ".join(f"{k}={toml_value(v)}" for k, v in values.items())
             raise StudyError("set", f"the variant {where} is not a valid scene: {err}") \
                 from None
 

@@ -29,7 +29,7 @@ import numpy as np
 from ..fem.contact_boundary import facet_normals, facet_points, tangent_frame
 from ..expressions import coordinates
 from .manufactured import TOLERANCE, on_wall
-from ..problem.checks import where
+from ..scene.errors import where
 from ..scene import SceneError
 
 

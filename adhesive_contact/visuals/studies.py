@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import NullFormatter
 
-from ..studies.sweep import show
+from ..storage import toml_value
 from .common import Units, plot_title, save_figure
 
 # ---------------------------------------------------------------- convergence
@@ -265,21 +265,21 @@ def figure_by_key(rows, keys, key, title, units=None, dim=2):
     matplotlib.figure.Figure
     """
     units = units or Units()
-    values = list(dict.fromkeys(show(row[key]) for row in rows))
-    raw = {show(row[key]): row[key] for row in rows}
+    values = list(dict.fromkeys(toml_value(row[key]) for row in rows))
+    raw = {toml_value(row[key]): row[key] for row in rows}
     numbers = _numbers([raw[v] for v in values])
     position = ({v: x for v, x in zip(values, numbers)} if numbers is not None
                 else {v: i for i, v in enumerate(values)})
     others = [k for k in keys if k != key]
     groups = {}
     for row in rows:
-        label = ", ".join(f"{k} = {show(row[k])}" for k in others)
+        label = ", ".join(f"{k} = {toml_value(row[k])}" for k in others)
         groups.setdefault(label, []).append(row)
     fig, axes = plt.subplots(2, 2, figsize=(10.5, 7.5), sharex=True, layout="constrained")
     for (column, label), ax in zip(PANELS, axes.ravel()):
         for group, members in groups.items():
-            members = sorted(members, key=lambda r: position[show(r[key])])
-            x = np.array([position[show(r[key])] for r in members], dtype=float)
+            members = sorted(members, key=lambda r: position[toml_value(r[key])])
+            x = np.array([position[toml_value(r[key])] for r in members], dtype=float)
             ok = np.array([r["outcome"] == "ok" for r in members])
             y = np.array([_value(r, column) for r in members])
             ax.plot(x[ok], y[ok], "o-", label=group or None)
