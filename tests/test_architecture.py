@@ -4,6 +4,7 @@ command line, the command line draws nothing itself, and no module grows
 past 700 lines."""
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -109,3 +110,10 @@ def test_the_command_line_draws_nothing_and_stays_small():
 def test_no_module_over_700_lines():
     for path in list(PACKAGE.rglob("*.py")) + list(CLI.glob("*.py")):
         assert len(path.read_text().splitlines()) <= 700, path.relative_to(ROOT)
+
+
+def test_every_test_file_is_in_the_verification_map():
+    table = (ROOT / "docs" / "verification.md").read_text()
+    listed = set(re.findall(r"^\| `(test_\w+\.py)` \|", table, re.M))
+    present = {path.name for path in (ROOT / "tests").glob("test_*.py")}
+    assert listed == present

@@ -1,12 +1,17 @@
 """Tests for the restricted expression evaluator."""
+
 import ast
 import inspect
 
 import numpy as np
 import pytest
+from adhesive_contact_cli.main import main
+from click.testing import CliRunner
+from conftest import law, scene_dict, to_toml
 
 from adhesive_contact import expressions
 from adhesive_contact.expressions import Expression, ExpressionError, compile_expression
+
 
 X = np.linspace(0.0, 2.0, 11)
 Y = np.linspace(-1.0, 1.0, 11)
@@ -208,3 +213,80 @@ def test_numpy_and_sympy_forms_of_each_function_agree(name):
     symbol = sympy.Symbol("x")
     exact = sympy.lambdify(symbol, to_sympy(expr, {"x": symbol}), modules="numpy")
     np.testing.assert_allclose(expr(x), exact(x) + 0 * x, rtol=1e-14, atol=0)
+
+
+# ----------------------------------------------------------------
+# The evaluator as the scene meets it: refused expressions are exit 2, huge
+# results are refused where they are used, comparisons and flat sums evaluate
+# in float64 and in order.
+
+
+BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
+                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def solve_scene(tmp_path, data, *extra):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(data if isinstance(data, str) else to_toml(data))
+    out = tmp_path / "out"
+    return run("solve", scene, "--out", out, *extra), out
+
+
+def assert_refused(result, out, needle):
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2, (result.stderr, result.exception)
+    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("source, message", [
+    ("x.real", "attribute access is not allowed"),
+    ("().__class__.__bases__", "attribute access is not allowed"),
+    ("__import__('os').system('true')", "attribute access is not allowed"),
+    ("__import__('os')", "function '__import__' is not allowed"),
+    ("open('/etc/passwd')", "function 'open' is not allowed"),
+    ("(lambda: 1)()", "only calls to named functions"),
+    ("lambda: 1", "lambda is not allowed"),
+    ("[i for i in (1, 2)]", "comprehensions are not allowed"),
+    ("sum(i for i in (1, 2))", "function 'sum' is not allowed"),
+    ("'abc'", "string literals are not allowed"),
+    ("sin('x')", "string literals are not allowed"),
+    ("os", "name 'os' is not allowed"),
+    ("x" * 2001, "too long"),
+    ("(" * 101 + "x" + ")" * 101, "nested too deeply"),
+    ("-" * 200 + "x", "nested too deeply"),
+    ("1" * 400, "number literal is too large"),
+])
+def test_evaluator_refuses_with_exit_2(tmp_path, source, message):
+    with pytest.raises(Exception, match=message):
+        compile_expression(source)
+    result, out = solve_scene(tmp_path, scene_dict({"loads.body": [source, "0"]}, BLOCK))
+    assert_refused(result, out, message)
+    assert result.stderr.startswith("error: loads.body[0]: ")
+
+
+@pytest.mark.parametrize("source", ["9**9**9", "10**10**10", "x**1e308 + 2", "exp(1e5*x)",
+                                    "1e308*10*x", "2**2**2**2**2**2"])
+def test_huge_results_are_refused_where_used(tmp_path, source):
+    result, out = solve_scene(tmp_path, scene_dict({"loads.body": ["0", source]}, BLOCK))
+    assert_refused(result, out, "loads.body[1]: is not finite: inf at (")
+
+
+def test_a_function_of_a_comparison_is_computed_in_float64():
+    value = compile_expression("exp(x > 1)")(np.array([2.0, 0.0]))
+    assert value.dtype == np.float64
+    assert value.tolist() == [np.exp(1.0), 1.0]   # was 2.71875 (float16)
+
+
+def test_a_flat_sum_is_not_nested_and_evaluates_in_order():
+    terms = [f"{i}*x" for i in range(1, 300)]    # 299 terms, 1700 characters
+    x = np.array([0.5, 3.0])
+    expected = np.zeros(2)
+    for i in range(1, 300):
+        expected = expected + i * x
+    assert compile_expression("+".join(terms))(x).tolist() == expected.tolist()
+    assert compile_expression("-".join(["x"] * 900))(x).tolist() == (-898 * x).tolist()

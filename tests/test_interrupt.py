@@ -13,9 +13,11 @@ import time
 
 import numpy as np
 import pytest
+from adhesive_contact_cli import output as output_module
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import law, scene_dict, to_toml
+from conftest import law, prony, scene_dict, to_toml
+
 
 # a small block pushed onto a compliant foundation: a few ms per step, so
 # 4000 steps run for many seconds unless interrupted
@@ -129,3 +131,80 @@ def test_ctrl_c_stops_a_sweep_which_resumes_from_the_runs_done(tmp_path, jobs):
                             cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert f"{6 - done} computed now, {done} loaded" in result.stdout
+
+
+# ----------------------------------------------------------------
+# Staging folders of killed runs are removed by the next run.
+
+
+BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
+                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def solve_scene(tmp_path, data, *extra):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(data if isinstance(data, str) else to_toml(data))
+    out = tmp_path / "out"
+    return run("solve", scene, "--out", out, *extra), out
+
+
+def dead_pid():
+    """The pid of a process that has ended."""
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+def test_staging_folders_of_killed_runs_are_removed(tmp_path):
+    stale = tmp_path / f"out.tmp-{dead_pid()}-abcd"
+    live = tmp_path / f"out.tmp-{os.getpid()}-efgh"
+    other = tmp_path / "out.tmp-notes"
+    for folder in (stale, live, other):
+        folder.mkdir()
+        (folder / "summary.json").write_text("{")
+    result, out = solve_scene(tmp_path, BLOCK)
+    assert result.exit_code == 0, result.stderr
+    assert not stale.exists() and live.exists() and other.exists()
+    inside = out / f".adhcontact.tmp-{dead_pid()}-ijkl"
+    inside.mkdir()
+    assert output_module.remove_stale(out, ".adhcontact.tmp-") == [inside.name]
+
+
+# ----------------------------------------------------------------
+# A sweep killed mid-run loses and recomputes nothing.
+
+
+SWEEP = scene_dict({"mesh.cells": [8, 4], "time.steps": 60,
+                    "memory": prony((50.0, 0.3, 0.5))}, BLOCK)
+
+
+def test_a_sweep_killed_mid_run_loses_and_recomputes_nothing(tmp_path):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(scene_dict({"time.steps": 400}, SWEEP)))
+    out = tmp_path / "out"
+    args = ["sweep", str(scene), "--set", "contact.normal.c=50,60,70,80,90,100", "--out",
+            str(out)]
+    child = subprocess.Popen([sys.executable, "-c", "from adhesive_contact_cli.main import "
+                              "main; main()", *args], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+    runs = out / "runs"
+    while child.poll() is None and not list(runs.glob("run_*.json")):
+        time.sleep(0.02)
+    child.send_signal(signal.SIGKILL)
+    child.wait()
+    saved = {p.name: p.read_bytes() for p in runs.glob("run_*.json")}
+    assert 1 <= len(saved) < 6
+    # no file that looks whole but is not: records parse, the rest is named tmp
+    for path in runs.iterdir():
+        if path.name in saved:
+            assert json.loads(saved[path.name])["values"]
+        else:
+            assert path.name.startswith(".") and ".tmp-" in path.name
+    result = run(*args)
+    assert result.exit_code == 0, result.stderr
+    assert f"{6 - len(saved)} computed now, {len(saved)} loaded" in result.stdout
+    assert all((runs / name).read_bytes() == data for name, data in saved.items())

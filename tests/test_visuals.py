@@ -9,6 +9,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+from adhesive_contact_cli.main import main
+from click.testing import CliRunner
+from conftest import law, scene_dict, to_toml
+
+from adhesive_contact.visuals import common as figure_common
+from adhesive_contact.visuals import solution as run_figures
+
+
 ROOT = Path(__file__).resolve().parents[1]
 
 #: a small glued strip lifted at its top, solved in a fresh process (the
@@ -94,3 +102,42 @@ def test_no_cli_module_imports_matplotlib_and_the_library_never_calls_use():
     calls = re.compile(r"matplotlib\.use\(|\buse\(\s*[\"']agg", re.IGNORECASE)
     assert [str(p.relative_to(ROOT)) for p in (ROOT / "adhesive_contact").rglob("*.py")
             if calls.search(p.read_text())] == []
+
+
+# ----------------------------------------------------------------
+# Figures that cannot cost the data: a dollar in the title is drawn, a
+# plot that fails is a warning and the other outputs are kept.
+
+
+BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
+                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def solve_scene(tmp_path, data, *extra):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(data if isinstance(data, str) else to_toml(data))
+    out = tmp_path / "out"
+    return run("solve", scene, "--out", out, *extra), out
+
+
+def test_a_dollar_in_the_title_is_drawn(tmp_path):
+    result, out = solve_scene(tmp_path, scene_dict({"title": "$x^$ and $"}, BLOCK))
+    assert result.exit_code == 0, result.stderr
+    assert {"deformed.png", "beta.png", "contact_traction.png"} <= set(os.listdir(out))
+    assert figure_common.plot_title("$x^$") == r"\$x^\$"
+    assert len(figure_common.plot_title("a" * 500)) == figure_common.TITLE_CHARS
+
+
+def test_a_plot_that_fails_is_a_warning_and_the_data_is_kept(tmp_path, monkeypatch):
+    def broken(solution, path):
+        raise RuntimeError("no font")
+    monkeypatch.setattr(run_figures, "plot_beta", broken)
+    result, out = solve_scene(tmp_path, BLOCK)
+    assert result.exit_code == 0, result.stderr
+    assert "warning: beta.png was not drawn: RuntimeError: no font" in result.stderr
+    assert {"summary.json", "solution.npz", "deformed.png"} <= set(os.listdir(out))
+    assert "beta.png" not in os.listdir(out)

@@ -31,6 +31,8 @@ def test_every_committed_scene_runs(path):
         return
     scene = replace(scene, steps=min(scene.steps, 4), T=scene.T * min(scene.steps, 4) / scene.steps)
     solution = solve(build_problem(scene))
+    assert solution.success, solution.message
+    assert np.all(solution.residual <= scene.solver.tol)
     assert np.isfinite(solution.u).all()
     if solution.beta.size:
         assert (solution.beta >= 0).all() and (solution.beta <= 1).all()
@@ -40,6 +42,7 @@ def test_wall_scene_shows_wall_compliance_and_separation():
     """What studies/README.md says of wall.toml at t = 1: 13 nodes on the wall,
     14 in compliance, 38 separated, and the wall never crossed."""
     solution = solve(build_problem(parse_scene((ROOT / "studies/scenes/wall.toml").read_text())))
+    assert solution.success, solution.message
     un = solution.normal_displacement[-1]
     on_wall = solution.on_wall[-1]
     assert (on_wall.sum(), ((un > 0) & ~on_wall).sum(), (un < 0).sum()) == (13, 14, 38)

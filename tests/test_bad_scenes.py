@@ -1,0 +1,98 @@
+"""Bad scenes found in review: each ends as exit 2 with one line naming the
+key (a value that is not finite where it is used, a TOML nested too deep,
+an [exact] scene beyond what sympy may be given), or as a correct result."""
+
+
+import pytest
+from adhesive_contact_cli.main import main
+from click.testing import CliRunner
+from conftest import DELETE, law, scene_dict, to_toml
+
+from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
+from adhesive_contact.verification import manufactured
+
+BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
+                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
+#: a manufactured scene (its loads come from [exact])
+EXACT = {"dim": 2, "mesh": {"domain": "rectangle", "size": [1.0, 1.0], "cells": [2, 2]},
+         "boundary": {"dirichlet": ["left"]}, "material": {"E": 100.0, "nu": 0.3},
+         "time": {"T": 1.0, "steps": 1}, "exact": {"u": ["x*t", "0"]}}
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def solve_scene(tmp_path, data, *extra):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(data if isinstance(data, str) else to_toml(data))
+    out = tmp_path / "out"
+    return run("solve", scene, "--out", out, *extra), out
+
+
+def assert_refused(result, out, needle):
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2, (result.stderr, result.exception)
+    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("changes, base, needle", [
+    # loads that are not finite were accepted and failed at step 0 (exit 1)
+    ({"loads.body": ["9**9**9", "0"]}, BLOCK, "loads.body[0]: is not finite: inf at ("),
+    ({"loads.body": ["0", "1e308*10"]}, BLOCK, "loads.body[1]: is not finite: inf"),
+    ({"loads.body": ["sqrt(-1 - x)", "0"]}, BLOCK, "loads.body[0]: is not finite: nan"),
+    ({"boundary.contact": DELETE, "contact": DELETE, "loads.body": ["0/0", "0"]}, BLOCK,
+     "loads.body[0]: is not finite: nan"),   # a quiet NaN with exit 0 before
+    ({"boundary.contact": ["bottom", "left"], "loads.traction": {"right": ["0", "1/(t - 1)"]}},
+     BLOCK, "loads.traction.right[1]: is not finite: inf at ("),   # at t = T
+    # MemoryError / ValueError tracebacks
+    ({"mesh.cells": [200000, 200000]}, BLOCK, "mesh.cells: gives 4e+10 nodes"),
+    ({"time.steps": 1000000000000}, BLOCK, "time.steps: must be an integer in 1..1e+08"),
+    ({"time.steps": 2**63 - 1}, BLOCK, "time.steps: must be an integer in 1..1e+08"),
+    ({"mesh.cells": [2**62, 1]}, BLOCK, "mesh.cells: gives 9.22e+18 nodes"),
+    # [exact]: hangs in sympy, OverflowError, KeyError
+    ({"exact.u": ["9**9**9*x", "0"]}, EXACT, "exact.u[0]: a constant part is not finite"),
+    ({"exact.u": ["10**10**10", "0"]}, EXACT, "exact.u[0]: a constant part is not finite"),
+    ({"exact.u": ["x**1e308", "0"]}, EXACT, "exact.u[0]: the exponent 1e+308 is too large"),
+    ({"exact.u": ["1/0*x", "0"]}, EXACT, "exact.u[0]: a constant part is not finite"),
+    ({"exact.u": ["x", "log(x - 2)"]}, EXACT, "exact.u[1]: is not finite: nan at ("),
+    # a 100,000-character title took 30 s in the plots
+    ({"title": "a" * 100000}, BLOCK, "title: must have at most 500 characters, got 100000"),
+    # tolerances that accept the start as the solution (0 iterations, exit 0)
+    ({"solver.tol": 1e300}, BLOCK, "solver.tol: must lie in [1e-14, 0.001]"),
+    ({"solver.tol": 1.0, "solver.max_iter": 1}, BLOCK, "solver.tol: must lie in"),
+    ({"solver.max_iter": 10**9}, BLOCK, "solver.max_iter: must be an integer in 1..10000"),
+    # "Factor is exactly singular"
+    ({"mesh.size": [float("inf"), 1.0]}, BLOCK, "mesh.size[0]: must be a finite length"),
+    ({"mesh.size": [1e-300, 1e-300]}, BLOCK, "mesh.size[0]: must be a finite length"),
+    ({"mesh.size": [1.0, 1e-5], "mesh.cells": [1, 1]}, BLOCK, "elongated more than 1000:1"),
+    ({"memory": {"kernel": "function", "r": "exp(-t)/0", "E": 100.0, "nu": 0.3}}, BLOCK,
+     "memory.r: is not finite: r(0) = inf"),
+    ({"memory": {"kernel": "function", "r": "1/(t - 0.5)", "E": 100.0, "nu": 0.3}}, BLOCK,
+     "memory.r: is not finite: r(0.5) = inf"),
+])
+def test_defect_is_refused_with_one_line_naming_the_key(tmp_path, changes, base, needle):
+    result, out = solve_scene(tmp_path, scene_dict(changes, base))
+    assert_refused(result, out, needle)
+
+
+def test_deeply_nested_toml_is_one_line(tmp_path):
+    result, out = solve_scene(tmp_path, "a = " + "[" * 5000 + "]" * 5000 + "\n")
+    assert_refused(result, out, "nested too deeply")
+
+
+def test_exact_scene_refused_before_sympy_sees_it(tmp_path, monkeypatch):
+    """The refusal of a huge exponent comes from the scene's own check: the
+    derivation (which would hang on 9**9**9) is never started."""
+    def never(*args, **kwargs):
+        raise AssertionError("sympy was given the expression")
+    monkeypatch.setattr(manufactured.ManufacturedSolution, "__init__", never)
+    for source in ("9**9**9*x", "x**1e308", "x**(2**7)", "2**x**70"):
+        with pytest.raises(SceneError, match=r"exact.u\[0\]: "):
+            build_problem(scene_from_dict(scene_dict({"exact.u": [source, "0"]}, EXACT)))
+
+
+def test_exact_scene_within_the_bounds_still_derives_its_loads():
+    problem = build_problem(scene_from_dict(scene_dict({"exact.u": ["x**3*t", "0"]}, EXACT)))
+    assert solve(problem).success
