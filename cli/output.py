@@ -11,7 +11,7 @@ adds the rest:
   smallness terms (null without contact), the warnings of the problem,
   timings, the linear backend, the estimated resources beside those used
   (``resources``), iterations and one record per time level
-  (:func:`~.postprocess.step_records`);
+  (:func:`~.summary.step_records`);
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys);
 - ``solution.xdmf`` + ``solution.h5`` and ``contact.xdmf`` + ``contact.h5``
   (:mod:`adhesive_contact.io.xdmf`), written by the recorder;
@@ -33,7 +33,7 @@ from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 from adhesive_contact.visuals import PLOT_NAMES, write_plots
 
-from .postprocess import smallness_record, step_records
+from .summary import smallness_record, step_records
 
 #: the version of summary.json's layout (docs/outputs.md): raised when a key
 #: changes meaning or goes; new keys do not change it
