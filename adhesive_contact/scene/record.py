@@ -9,7 +9,6 @@ so that the studies of earlier scenes keep their identity.
 from pathlib import Path
 
 from .keys import default
-from .spec import ContactSpec
 
 
 def resolved(scene):
@@ -77,7 +76,7 @@ def _memory_record(memory):
 
 def _contact_record(contact):
     """{} for a scene without contact settings."""
-    if contact == ContactSpec():
+    if contact == type(contact)():        # every default: the scene said nothing
         return {}
     record = {} if contact.gap is None else {"gap": contact.gap.given}
     if contact.foundation is not None:

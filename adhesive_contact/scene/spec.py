@@ -13,6 +13,7 @@ defaults when absent.
 from dataclasses import dataclass, field
 
 from .keys import default
+from .record import resolved as resolved_record
 
 
 @dataclass(frozen=True)
@@ -225,5 +226,4 @@ class Scene:
     def resolved(self):
         """The scene with every default filled in, as a JSON-able dict of its
         tables (expressions as their text, or as the number given)."""
-        from .record import resolved   # the record reads these classes
-        return resolved(self)
+        return resolved_record(self)
