@@ -57,3 +57,20 @@ def test_progress_shows_t_and_the_newton_iterations():
     from adhesive_contact_cli.main import level_status
     assert level_status(None) is None
     assert level_status(SimpleNamespace(t=0.25, iterations=4)) == "t = 0.25, 4 Newton iterations"
+
+
+def test_check_and_sweep_show_the_stiffness_warning(tmp_path):
+    """A contact stiffness far from the body's needs no solution: ``check``
+    and ``sweep`` show it (the sweep once, naming the runs it holds for),
+    as ``solve`` does before a run."""
+    stiff = scene_dict({"contact.normal": {"law": "compliance", "c": 1e12}, "time.steps": 1})
+    path = tmp_path / "stiff.toml"
+    path.write_text(to_toml(stiff))
+    needle = "warning: contact.normal.c = 1e+12 times the body's size"
+    checked = CliRunner().invoke(main, ["check", str(path)])
+    assert checked.exit_code == 0 and needle in checked.stdout
+    swept = CliRunner().invoke(main, ["sweep", str(path), "--set", "time.steps=1,2",
+                                      "--out", str(tmp_path / "sweep")])
+    assert swept.exit_code == 0, swept.stderr
+    (line,) = [w for w in swept.stderr.splitlines() if "contact.normal.c = 1e+12" in w]
+    assert line.startswith("warning: run 0, 1: contact.normal.c = 1e+12")
