@@ -252,3 +252,33 @@ def runner():
     if "mix_stderr" in inspect.signature(CliRunner).parameters:
         return CliRunner(mix_stderr=False)
     return CliRunner()
+
+
+#: a block on a compliant foundation, loaded down in time (two steps)
+COMPLIANT_BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2],
+                              "loads.body": ["0", "-10*t"],
+                              "contact.normal": law("compliance", c=100.0), "time.steps": 2})
+
+
+def invoke(*args):
+    """``adhcontact ARGS`` in this process (click's runner)."""
+    from adhesive_contact_cli.main import main
+    from click.testing import CliRunner
+
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def solve_scene(tmp_path, data, *extra):
+    """``adhcontact solve`` of a scene (TOML text or a dict) into tmp_path/out."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(data if isinstance(data, str) else to_toml(data))
+    out = tmp_path / "out"
+    return invoke("solve", scene, "--out", out, *extra), out
+
+
+def assert_refused(result, out, needle):
+    """Exit 2, one line "error: ..." holding ``needle``, and nothing written."""
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2, (result.stderr, result.exception)
+    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
+    assert not out.exists()

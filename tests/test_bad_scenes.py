@@ -4,9 +4,7 @@ an [exact] scene beyond what sympy may be given), or as a correct result."""
 
 
 import pytest
-from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import DELETE, law, scene_dict, to_toml
+from conftest import DELETE, assert_refused, law, scene_dict, solve_scene
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.verification import manufactured
@@ -17,24 +15,6 @@ BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", 
 EXACT = {"dim": 2, "mesh": {"domain": "rectangle", "size": [1.0, 1.0], "cells": [2, 2]},
          "boundary": {"dirichlet": ["left"]}, "material": {"E": 100.0, "nu": 0.3},
          "time": {"T": 1.0, "steps": 1}, "exact": {"u": ["x*t", "0"]}}
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def solve_scene(tmp_path, data, *extra):
-    scene = tmp_path / "scene.toml"
-    scene.write_text(data if isinstance(data, str) else to_toml(data))
-    out = tmp_path / "out"
-    return run("solve", scene, "--out", out, *extra), out
-
-
-def assert_refused(result, out, needle):
-    lines = result.stderr.strip().splitlines()
-    assert result.exit_code == 2, (result.stderr, result.exception)
-    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
-    assert not out.exists()
 
 
 @pytest.mark.parametrize("changes, base, needle", [

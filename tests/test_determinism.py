@@ -4,31 +4,21 @@ same records with one or two jobs."""
 import json
 
 import numpy as np
-from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import law, prony, scene_dict, to_toml
+from conftest import COMPLIANT_BLOCK, invoke, law, prony, scene_dict, to_toml
 
 from adhesive_contact import build_problem, scene_from_dict, solve
-
-BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
-                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
 
 def test_the_same_scene_gives_bit_identical_arrays():
     scene = scene_from_dict(scene_dict({"memory": prony((50.0, 0.3, 0.5)),
                                         "contact.friction": law("tresca", mu=0.3),
-                                        "loads.body": ["5*t", "-40*t"]}, BLOCK))
+                                        "loads.body": ["5*t", "-40*t"]}, COMPLIANT_BLOCK))
     first, second = (solve(build_problem(scene)) for _ in range(2))
     for name in ("u", "beta", "t", "iterations"):
         assert np.array_equal(getattr(first, name), getattr(second, name)), name
 
 
 SWEEP = scene_dict({"mesh.cells": [8, 4], "time.steps": 60,
-                    "memory": prony((50.0, 0.3, 0.5))}, BLOCK)
+                    "memory": prony((50.0, 0.3, 0.5))}, COMPLIANT_BLOCK)
 
 
 def records(folder):
@@ -45,7 +35,7 @@ def test_a_sweep_gives_the_same_records_with_one_or_two_jobs(tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(to_toml(scene_dict({"time.steps": 3}, SWEEP)))
     for jobs in (1, 2):
-        result = run("sweep", scene, "--set", "contact.normal.c=50,100,200", "--jobs", jobs,
+        result = invoke("sweep", scene, "--set", "contact.normal.c=50,100,200", "--jobs", jobs,
                      "--out", tmp_path / f"jobs{jobs}")
         assert result.exit_code == 0, result.stderr
     one, two = records(tmp_path / "jobs1"), records(tmp_path / "jobs2")

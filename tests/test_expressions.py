@@ -5,9 +5,7 @@ import inspect
 
 import numpy as np
 import pytest
-from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import law, scene_dict, to_toml
+from conftest import COMPLIANT_BLOCK, assert_refused, scene_dict, solve_scene
 
 from adhesive_contact import expressions
 from adhesive_contact.expressions import Expression, ExpressionError, compile_expression
@@ -221,28 +219,6 @@ def test_numpy_and_sympy_forms_of_each_function_agree(name):
 # in float64 and in order.
 
 
-BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
-                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def solve_scene(tmp_path, data, *extra):
-    scene = tmp_path / "scene.toml"
-    scene.write_text(data if isinstance(data, str) else to_toml(data))
-    out = tmp_path / "out"
-    return run("solve", scene, "--out", out, *extra), out
-
-
-def assert_refused(result, out, needle):
-    lines = result.stderr.strip().splitlines()
-    assert result.exit_code == 2, (result.stderr, result.exception)
-    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
-    assert not out.exists()
-
-
 @pytest.mark.parametrize("source, message", [
     ("x.real", "attribute access is not allowed"),
     ("().__class__.__bases__", "attribute access is not allowed"),
@@ -264,7 +240,7 @@ def assert_refused(result, out, needle):
 def test_evaluator_refuses_with_exit_2(tmp_path, source, message):
     with pytest.raises(Exception, match=message):
         compile_expression(source)
-    result, out = solve_scene(tmp_path, scene_dict({"loads.body": [source, "0"]}, BLOCK))
+    result, out = solve_scene(tmp_path, scene_dict({"loads.body": [source, "0"]}, COMPLIANT_BLOCK))
     assert_refused(result, out, message)
     assert result.stderr.startswith("error: loads.body[0]: ")
 
@@ -272,7 +248,7 @@ def test_evaluator_refuses_with_exit_2(tmp_path, source, message):
 @pytest.mark.parametrize("source", ["9**9**9", "10**10**10", "x**1e308 + 2", "exp(1e5*x)",
                                     "1e308*10*x", "2**2**2**2**2**2"])
 def test_huge_results_are_refused_where_used(tmp_path, source):
-    result, out = solve_scene(tmp_path, scene_dict({"loads.body": ["0", source]}, BLOCK))
+    result, out = solve_scene(tmp_path, scene_dict({"loads.body": ["0", source]}, COMPLIANT_BLOCK))
     assert_refused(result, out, "loads.body[1]: is not finite: inf at (")
 
 

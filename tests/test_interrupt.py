@@ -16,7 +16,7 @@ import pytest
 from adhesive_contact_cli import output as output_module
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import law, prony, scene_dict, to_toml
+from conftest import COMPLIANT_BLOCK, invoke, law, prony, scene_dict, solve_scene, to_toml
 
 
 # a small block pushed onto a compliant foundation: a few ms per step, so
@@ -137,21 +137,6 @@ def test_ctrl_c_stops_a_sweep_which_resumes_from_the_runs_done(tmp_path, jobs):
 # Staging folders of killed runs are removed by the next run.
 
 
-BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
-                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def solve_scene(tmp_path, data, *extra):
-    scene = tmp_path / "scene.toml"
-    scene.write_text(data if isinstance(data, str) else to_toml(data))
-    out = tmp_path / "out"
-    return run("solve", scene, "--out", out, *extra), out
-
-
 def dead_pid():
     """The pid of a process that has ended."""
     child = subprocess.Popen([sys.executable, "-c", "pass"])
@@ -166,7 +151,7 @@ def test_staging_folders_of_killed_runs_are_removed(tmp_path):
     for folder in (stale, live, other):
         folder.mkdir()
         (folder / "summary.json").write_text("{")
-    result, out = solve_scene(tmp_path, BLOCK)
+    result, out = solve_scene(tmp_path, COMPLIANT_BLOCK)
     assert result.exit_code == 0, result.stderr
     assert not stale.exists() and live.exists() and other.exists()
     inside = out / f".adhcontact.tmp-{dead_pid()}-ijkl"
@@ -179,7 +164,7 @@ def test_staging_folders_of_killed_runs_are_removed(tmp_path):
 
 
 SWEEP = scene_dict({"mesh.cells": [8, 4], "time.steps": 60,
-                    "memory": prony((50.0, 0.3, 0.5))}, BLOCK)
+                    "memory": prony((50.0, 0.3, 0.5))}, COMPLIANT_BLOCK)
 
 
 def test_a_sweep_killed_mid_run_loses_and_recomputes_nothing(tmp_path):
@@ -204,7 +189,7 @@ def test_a_sweep_killed_mid_run_loses_and_recomputes_nothing(tmp_path):
             assert json.loads(saved[path.name])["values"]
         else:
             assert path.name.startswith(".") and ".tmp-" in path.name
-    result = run(*args)
+    result = invoke(*args)
     assert result.exit_code == 0, result.stderr
     assert f"{6 - len(saved)} computed now, {len(saved)} loaded" in result.stdout
     assert all((runs / name).read_bytes() == data for name, data in saved.items())

@@ -6,38 +6,14 @@ check their largest run."""
 import json
 import os
 
-from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import law, scene_dict, to_toml
+from conftest import COMPLIANT_BLOCK, assert_refused, invoke, scene_dict, solve_scene, to_toml
 
 from adhesive_contact import build_problem, resources, scene_from_dict
-
-BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
-                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def solve_scene(tmp_path, data, *extra):
-    scene = tmp_path / "scene.toml"
-    scene.write_text(data if isinstance(data, str) else to_toml(data))
-    out = tmp_path / "out"
-    return run("solve", scene, "--out", out, *extra), out
-
-
-def assert_refused(result, out, needle):
-    lines = result.stderr.strip().splitlines()
-    assert result.exit_code == 2, (result.stderr, result.exception)
-    assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
-    assert not out.exists()
-
 
 def test_the_estimate_counts_what_the_build_makes():
     for changes in ({}, {"mesh.pattern": "cross", "mesh.refine": 2},
                     {"boundary.contact": ["bottom", "left"], "mesh.refine": 1}):
-        scene = scene_from_dict(scene_dict(changes, BLOCK))
+        scene = scene_from_dict(scene_dict(changes, COMPLIANT_BLOCK))
         est, problem = resources.estimate(scene), build_problem(scene)
         assert est.dofs == problem.ndofs and est.cells == problem.mesh.t.shape[1]
         # an upper bound: a corner shared by two contact sides is counted
@@ -48,12 +24,12 @@ def test_the_estimate_counts_what_the_build_makes():
 
 
 def test_a_scene_larger_than_the_machine_is_refused_unless_forced(tmp_path, monkeypatch):
-    est = resources.estimate(scene_from_dict(BLOCK))
+    est = resources.estimate(scene_from_dict(COMPLIANT_BLOCK))
     monkeypatch.setattr(resources, "available_memory", lambda: est.memory_bytes / 2)
-    result, out = solve_scene(tmp_path, BLOCK)
+    result, out = solve_scene(tmp_path, COMPLIANT_BLOCK)
     assert_refused(result, out, "is too large for this machine: it would need about")
     assert "--force" in result.stderr and "mesh.cells" in result.stderr
-    result, out = solve_scene(tmp_path, BLOCK, "--force")
+    result, out = solve_scene(tmp_path, COMPLIANT_BLOCK, "--force")
     assert result.exit_code == 0, result.stderr
     record = json.loads((out / "summary.json").read_text())["resources"]
     assert record["estimate"]["dofs"] == record["used"]["dofs"] == 30
@@ -63,19 +39,19 @@ def test_a_scene_larger_than_the_machine_is_refused_unless_forced(tmp_path, monk
 
 def test_a_run_longer_than_a_day_is_refused(tmp_path):
     result, out = solve_scene(tmp_path, scene_dict({"time.steps": 10**8 - 1,
-                                                    "mesh.cells": [1, 1]}, BLOCK))
+                                                    "mesh.cells": [1, 1]}, COMPLIANT_BLOCK))
     assert_refused(result, out, "is too large for this machine")
 
 
 def test_converge_and_sweep_check_their_largest_run_and_their_out(tmp_path):
     scene = tmp_path / "scene.toml"
-    scene.write_text(to_toml(BLOCK))
-    result = run("converge", scene, "--param", "k", "--levels", 20, "--steps", 1000,
+    scene.write_text(to_toml(COMPLIANT_BLOCK))
+    result = invoke("converge", scene, "--param", "k", "--levels", 20, "--steps", 1000,
                  "--out", tmp_path / "c")
     assert_refused(result, tmp_path / "c", "the largest run of the study is too large")
-    result = run("converge", scene, "--param", "k", "--levels", 40, "--out", tmp_path / "c")
+    result = invoke("converge", scene, "--param", "k", "--levels", 40, "--out", tmp_path / "c")
     assert_refused(result, tmp_path / "c", "--levels")
-    result = run("sweep", scene, "--set", "time.steps=2,99999999", "--out", tmp_path / "s")
+    result = invoke("sweep", scene, "--set", "time.steps=2,99999999", "--out", tmp_path / "s")
     assert_refused(result, tmp_path / "s", "the variant time.steps=99999999 is too large")
     locked = tmp_path / "locked"
     locked.mkdir(mode=0o500)
@@ -84,5 +60,5 @@ def test_converge_and_sweep_check_their_largest_run_and_their_out(tmp_path):
         locked.write_text("a file")
     for args in (("converge", scene, "--param", "k"), ("sweep", scene, "--set",
                                                        "time.steps=1,2")):
-        result = run(*args, "--out", locked / "out")
+        result = invoke(*args, "--out", locked / "out")
         assert_refused(result, locked / "out", "cannot be written")

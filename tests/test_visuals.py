@@ -9,9 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from adhesive_contact_cli.main import main
-from click.testing import CliRunner
-from conftest import law, scene_dict, to_toml
+from conftest import COMPLIANT_BLOCK, scene_dict, solve_scene
 
 from adhesive_contact.visuals import common as figure_common
 from adhesive_contact.visuals import solution as run_figures
@@ -109,23 +107,8 @@ def test_no_cli_module_imports_matplotlib_and_the_library_never_calls_use():
 # plot that fails is a warning and the other outputs are kept.
 
 
-BLOCK = scene_dict({"title": "block", "mesh.cells": [4, 2], "loads.body": ["0", "-10*t"],
-                    "contact.normal": law("compliance", c=100.0), "time.steps": 2})
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def solve_scene(tmp_path, data, *extra):
-    scene = tmp_path / "scene.toml"
-    scene.write_text(data if isinstance(data, str) else to_toml(data))
-    out = tmp_path / "out"
-    return run("solve", scene, "--out", out, *extra), out
-
-
 def test_a_dollar_in_the_title_is_drawn(tmp_path):
-    result, out = solve_scene(tmp_path, scene_dict({"title": "$x^$ and $"}, BLOCK))
+    result, out = solve_scene(tmp_path, scene_dict({"title": "$x^$ and $"}, COMPLIANT_BLOCK))
     assert result.exit_code == 0, result.stderr
     assert {"deformed.png", "beta.png", "contact_traction.png"} <= set(os.listdir(out))
     assert figure_common.plot_title("$x^$") == r"\$x^\$"
@@ -136,7 +119,7 @@ def test_a_plot_that_fails_is_a_warning_and_the_data_is_kept(tmp_path, monkeypat
     def broken(solution, path):
         raise RuntimeError("no font")
     monkeypatch.setattr(run_figures, "plot_beta", broken)
-    result, out = solve_scene(tmp_path, BLOCK)
+    result, out = solve_scene(tmp_path, COMPLIANT_BLOCK)
     assert result.exit_code == 0, result.stderr
     assert "warning: beta.png was not drawn: RuntimeError: no font" in result.stderr
     assert {"summary.json", "solution.npz", "deformed.png"} <= set(os.listdir(out))
