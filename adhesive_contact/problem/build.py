@@ -117,7 +117,8 @@ class Problem:
         """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
         upper = np.full(self.columns.size, np.inf)
         if self.gap is not None:
-            upper[self.normal_columns] = self.gap[n]
+            normal = self.normal_columns
+            upper[normal] = self.gap[n][self.columns[normal] // self.dim]
         return upper
 
 
@@ -138,8 +139,6 @@ def build_problem(scene):
     dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
     contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
     prescribed = prescribed_displacement(scene, mesh)
-    # a node with any held component leaves Γ_C (module adhesive_contact.dirichlet)
-    clamped_nodes = np.unique(prescribed.fixed // d)
     held = np.zeros(assembly.ndofs, dtype=bool)
     held[prescribed.fixed] = True
     free = np.flatnonzero(~held)
@@ -153,7 +152,8 @@ def build_problem(scene):
     boundary, gap, beta0 = None, None, np.zeros(0)
     columns = contact_positions = np.zeros(0, dtype=np.int64)
     if scene.has_contact_terms:
-        boundary = build_contact_boundary(mesh, contact_facets, clamped_nodes,
+        # every vertex of Γ_C is a contact node; its held components are no unknowns
+        boundary = build_contact_boundary(mesh, contact_facets, prescribed.fixed,
                                           scene.contact.quadrature, scene.contact.order)
         assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
         # without friction only u_ν enters the contact terms (the traces of
@@ -163,7 +163,7 @@ def build_problem(scene):
             tangential.size == 0
             or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
         columns = boundary.unknowns([0] if normal_only else np.arange(d))
-        contact_positions = position[boundary.dofs.ravel()[columns]]
+        contact_positions = position[boundary.frame_dofs.ravel()[columns]]
         if scene.contact.has_wall:
             gap = _gap(scene, mesh, boundary, times)
         beta0 = np.ones(boundary.facets.size)

@@ -43,14 +43,14 @@ def minimise(S, c, energy, upper, z0, options, kink=None):
         g = Sz - c + energy.gradient(z)
         if tan.size:
             # the kink's subgradient of minimal norm where ξ_a = 0
-            xi = z[tan]
+            xi = kink.xi(z)
             zero = ~np.any(xi != 0, axis=1)
             if zero.any():
-                h = g[tan[zero]]
+                h = kink.take(g)
                 hn = np.linalg.norm(h, axis=1)
-                slide = np.where(hn > kink.radius[zero],
-                                 1.0 - kink.radius[zero] / np.where(hn > 0, hn, 1.0), 0.0)
-                g[tan[zero]] = h * slide[:, None]
+                slide = np.where(hn > kink.radius,
+                                 1.0 - kink.radius / np.where(hn > 0, hn, 1.0), 0.0)
+                kink.put(g, zero, h * slide[:, None])
         return E, g
 
     bounds = [(None, None if not np.isfinite(b) else float(b)) for b in upper]
