@@ -21,7 +21,7 @@ def test_check_prints_what_a_run_would_be_and_writes_nothing(tmp_path, monkeypat
     assert result.exit_code == 0, result.output
     out = result.stdout
     assert "debonding: valid scene" in out
-    assert "80 contact facets, 80 contact nodes, 160 contact unknowns" in out
+    assert "80 contact facets, 81 contact nodes, 160 contact unknowns" in out
     assert "explicit Euler bound of the bonding law: k <= 0.06667 (k = 0.02: within" in out
     assert "smallness: m_A = 769.2" in out and "estimate: " in out
     resolved = json.loads(out[out.index("{"):])

@@ -138,14 +138,19 @@ def test_a_body_held_only_by_glue_is_told_what_to_hold_and_the_advice_works(dim)
     assert problem.prescribed.fixed.size == dim * np.isclose(problem.mesh.p[0], 0).sum()
 
 
-def test_a_contact_node_with_a_held_component_leaves_contact():
+def test_a_contact_node_with_a_held_component_stays_on_contact():
+    # the roller corner holds u_x = u_τ; its u_ν is a contact unknown
     data = scene_dict({"boundary.dirichlet": ["top"],
                        "boundary.displacement": {"left": ["0", "free"]},
                        "contact.normal": {"law": "compliance", "c": 10.0}})
     problem = build_problem(scene_from_dict(data))
     corner = np.flatnonzero((problem.mesh.p[0] == 0) & (problem.mesh.p[1] == 0))
-    assert corner.size == 1 and corner[0] not in problem.boundary.nodes
-    assert problem.boundary.nodes.size == 16      # 17 bottom nodes less the corner
+    assert corner.size == 1 and corner[0] in problem.boundary.nodes
+    assert problem.boundary.nodes.size == 17      # every bottom node
+    a = int(np.flatnonzero(problem.boundary.nodes == corner[0])[0])
+    assert problem.boundary.held[a].tolist() == [False, True]
+    # frictionless: the normal components are the unknowns, the corner's too
+    assert problem.columns.tolist() == list(range(0, 2 * 17, 2))
 
 
 def test_a_manufactured_solution_with_a_held_side_is_reproduced():

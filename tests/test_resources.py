@@ -17,8 +17,8 @@ def test_the_estimate_counts_what_the_build_makes():
         est, problem = resources.estimate(scene), build_problem(scene)
         assert est.dofs == problem.ndofs and est.cells == problem.mesh.t.shape[1]
         # an upper bound: a corner shared by two contact sides is counted
-        # twice, and one shared with a Dirichlet side (clamped) is counted
-        extra = 0 if len(scene.contact_sides) == 1 else 2
+        # twice (one shared with a Dirichlet side is a contact node)
+        extra = 0 if len(scene.contact_sides) == 1 else 1
         assert est.contact_nodes == problem.boundary.nodes.size + extra
         assert est.levels == scene.steps + 1
 

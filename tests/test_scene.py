@@ -164,7 +164,7 @@ def test_invalid_toml_is_a_scene_error():
 def test_geometry_checks_happen_at_build():
     data = base()
     data["contact"]["gap"] = "0.01 - 0.02*t"  # negative once t > 0.5
-    with pytest.raises(SceneError, match=r"contact.gap: must be finite and >= 0 on Γ_C, got -0.005 at \(0.5, 0\), t = 0.75"):
+    with pytest.raises(SceneError, match=r"contact.gap: must be finite and >= 0 on Γ_C, got -0.005 at \(0, 0\), t = 0.75"):
         build_problem(scene_from_dict(data))
     data = base()
     data["output"] = {"probes": [[1.0, 0.5], [3.0, 0.5]]}

@@ -13,9 +13,10 @@ body (including the memory history in f).
 
 A dof held by several sides (a corner node) must get the same value from
 each; its reaction is split equally between them, so that the side
-reactions add up to the total. A contact node with a held component
-leaves Γ_C (the prescription wins, as for a clamped node): its free
-components are then ordinary unknowns without contact terms.
+reactions add up to the total. A vertex of Γ_C with held components stays
+a contact node (:mod:`.contact_boundary`): the contact laws read its held
+components at g_D and act along its free ones as at any contact node;
+their force along a held dof is part of r_D, as the support's is.
 
 :func:`rigid_modes` gives the rigid motions whose restriction to the held
 dofs :func:`adhesive_contact.problem.checks.check_rigid_motions` reads.

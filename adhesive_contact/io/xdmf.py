@@ -122,7 +122,8 @@ class XdmfSeries:
 
     def _nodal(self, level):
         """The contact fields of a level at the points of ``contact.xdmf``
-        (0 at a clamped vertex)."""
+        (every vertex of Γ_C is a contact node; the force is 0 along a
+        held component, being in the side's reaction)."""
         fields = contact_fields(self.problem, level.contact_force, level.frame_displacement,
                                 level.on_wall, level.stuck)
         fields["on_wall"] = np.asarray(level.on_wall, dtype=float)

@@ -97,7 +97,6 @@ class HeldDofs:
     prescribed: object        # PrescribedDisplacement
     free: np.ndarray          # the free dofs
     position: np.ndarray      # (ndofs,) position of a dof within ``free``, −1 if held
-    clamped_nodes: np.ndarray  # nodes with a held component
     dirichlet_facets: np.ndarray
     contact_facets: np.ndarray
 
@@ -105,20 +104,16 @@ class HeldDofs:
 def held_dofs(scene, mesh, assembly):
     """The held dofs of ``[boundary]`` (checked: consistent, no rigid motion
     left free) and the free dofs, numbered."""
-    d = mesh.dim()
     dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
     contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
     prescribed = prescribed_displacement(scene, mesh)
     check_prescribed(prescribed, scene, mesh)
-    # a node with any held component leaves Γ_C (module adhesive_contact.fem.dirichlet)
-    clamped_nodes = np.unique(prescribed.fixed // d)
     held = np.zeros(assembly.ndofs, dtype=bool)
     held[prescribed.fixed] = True
     free = np.flatnonzero(~held)
     position = np.full(assembly.ndofs, -1)
     position[free] = np.arange(free.size)
-    return HeldDofs(prescribed, free, position, clamped_nodes, dirichlet_facets,
-                    contact_facets)
+    return HeldDofs(prescribed, free, position, dirichlet_facets, contact_facets)
 
 
 # ---------------------------------------------------------------- 3. laws
@@ -180,7 +175,8 @@ def contact(scene, mesh, assembly, held, laws, times):
     empty = np.zeros(0, dtype=np.int64)
     if not scene.has_contact_terms:
         return Contact(None, empty, empty, None)
-    boundary = build_contact_boundary(mesh, held.contact_facets, held.clamped_nodes,
+    # every vertex of Γ_C is a contact node; its held components are no unknowns
+    boundary = build_contact_boundary(mesh, held.contact_facets, held.prescribed.fixed,
                                       scene.contact.quadrature, scene.contact.order)
     assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
     # without friction only u_ν enters the contact terms (the traces of
@@ -190,7 +186,7 @@ def contact(scene, mesh, assembly, held, laws, times):
         tangential.size == 0
         or abs(boundary.normal_trace[:, tangential]).max() <= 1e-13)
     columns = boundary.unknowns([0] if normal_only else np.arange(d))
-    positions = held.position[boundary.dofs.ravel()[columns]]
+    positions = held.position[boundary.frame_dofs.ravel()[columns]]
     gap = gap_at_nodes(scene, mesh, boundary, times) if scene.contact.has_wall else None
     return Contact(boundary, columns, positions, gap)
 

@@ -71,5 +71,6 @@ class Problem:
         """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
         upper = np.full(self.columns.size, np.inf)
         if self.gap is not None:
-            upper[self.normal_columns] = self.gap[n]
+            normal = self.normal_columns
+            upper[normal] = self.gap[n][self.columns[normal] // self.dim]
         return upper

@@ -5,6 +5,9 @@
 (docs/scheme.md ('What a step solves')), with N, T the traces of :mod:`adhesive_contact.fem.contact_boundary`
 restricted to the unknowns the step solves for, β_q the P0 bonding of the
 facet holding q, and j_τ(β, ξ) = φ(β, |ξ|) radial (:mod:`adhesive_contact.laws`).
+A frame component the boundary holds is no unknown but enters the traces
+at its prescribed value: (N z)_q stands for N_F z + N_D z_D, z_D the held
+values of the step (:meth:`ContactEnergy.set_held`).
 
 ``gradient`` is ∇Φ where Φ is differentiable; at ξ_q = 0 the friction part
 is left out (its Clarke subdifferential is the ball of radius
@@ -58,29 +61,53 @@ class ContactEnergy:
         self.nz = size
         self.hessian_map = HessianMap(self.N if normal_law.active else None, self.T,
                                       self.w.size, size)
+        # the traces of the held components, and their part of u_ν, u_τ
+        self.held = np.flatnonzero(boundary.held.ravel())
+        self.N_held = boundary.normal_trace[:, self.held].tocsr()
+        self.T_held = ([t[:, self.held].tocsr() for t in boundary.tangential_trace]
+                       if friction is not None else [])
+        self.n0 = self.t0 = None
         self.set_bonding(beta)
 
     def set_bonding(self, beta):
         """Use β_n (nf,) per contact facet from now on."""
         self.beta = self.boundary.at_points(beta)
 
-    def _xi(self, z):
-        return np.stack([t @ z for t in self.T], axis=-1)  # (nq, d−1)
+    def set_held(self, values):
+        """Use the held values z_D from now on: ``values`` (nc·d,) the frame
+        components of g_D(t_n) (:meth:`~adhesive_contact.fem.contact_boundary.ContactBoundary.held_values`),
+        read at the held components; None for none held."""
+        if values is None or self.held.size == 0:
+            self.n0 = self.t0 = None
+            return
+        v = values[self.held]
+        self.n0 = self.N_held @ v
+        self.t0 = np.stack([t @ v for t in self.T_held], axis=-1) if self.T_held else None
+
+    def normal(self, z):
+        """u_ν at the points (nq,)."""
+        r = self.N @ z
+        return r if self.n0 is None else r + self.n0
+
+    def tangential(self, z):
+        """u_τ at the points (nq, d−1) (with friction)."""
+        xi = np.stack([t @ z for t in self.T], axis=-1)
+        return xi if self.t0 is None else xi + self.t0
 
     def value(self, z):
         out = 0.0
         if self.normal_law.active:
-            out += self.w @ self.normal_law.potential(self.beta, self.N @ z)
+            out += self.w @ self.normal_law.potential(self.beta, self.normal(z))
         if self.friction is not None:
-            out += self.w @ self.friction.potential(self.beta, self._xi(z))
+            out += self.w @ self.friction.potential(self.beta, self.tangential(z))
         return float(out)
 
     def gradient(self, z):
         g = np.zeros(self.nz)
         if self.normal_law.active:
-            g += self.N.T @ (self.w * self.normal_law.value(self.beta, self.N @ z))
+            g += self.N.T @ (self.w * self.normal_law.value(self.beta, self.normal(z)))
         if self.friction is not None:
-            force = self.w[:, None] * self.friction.gradient(self.beta, self._xi(z))
+            force = self.w[:, None] * self.friction.gradient(self.beta, self.tangential(z))
             for i, t in enumerate(self.T):
                 g += t.T @ force[:, i]
         return g
@@ -94,9 +121,9 @@ class ContactEnergy:
         per call)."""
         normal = blocks = None
         if self.normal_law.active:
-            normal = self.w * self.normal_law.derivative(self.beta, self.N @ z)
+            normal = self.w * self.normal_law.derivative(self.beta, self.normal(z))
         if self.friction is not None:
-            xi = self._xi(z)
+            xi = self.tangential(z)
             s = np.linalg.norm(xi, axis=-1)
             sf = np.maximum(s, s_floor)
             dd = self.friction.ddphi(self.beta, sf)
@@ -117,7 +144,7 @@ class ContactEnergy:
         """κ_a = Σ_{q at a} w_q φ'(β_q, 0+) per contact node (nodal rule)."""
         if self.friction is None:
             return np.zeros(n_nodes)
-        keep = nodes_of_points >= 0   # clamped vertices carry no unknown
+        keep = nodes_of_points >= 0   # every point of the nodal rule reads a node
         return np.bincount(nodes_of_points[keep],
                            (self.w * self.friction.kink(self.beta))[keep], minlength=n_nodes)
 

@@ -10,7 +10,7 @@ and after each level that
   and β² then revives the glue. Not for a manufactured solution: its
   source s_β breaks the invariance of [0, 1] (F ≥ 0 for β ≤ 0, F ≤ 0 for
   β ≥ 1), so a coarse k may leave it by the discretisation error alone;
-- u_ν ≤ g at the contact nodes up to round-off (``WALL_SLACK`` relative to
+- u_ν ≤ g at the contact nodes whose u_ν is not held, up to round-off (``WALL_SLACK`` relative to
   the size of g and u_ν): the exact step methods project onto the wall.
   Not for ``solver.method = "penalty"``, which solves a nearby problem
   and leaves a violation by design; it is recorded
@@ -84,7 +84,8 @@ def check_level(problem, level):
     exact = problem.scene.solver.method in EXACT
     if exact and gap is not None and level.frame_displacement.shape[0]:
         u_nu = level.frame_displacement[:, 0]
-        excess = u_nu - gap[n]
+        # the wall acts where u_ν is free: a held u_ν is the scene's to set
+        excess = np.where(problem.boundary.held[:, 0], -np.inf, u_nu - gap[n])
         worst = int(np.argmax(excess))
         finite = np.isfinite(gap[n])   # +inf: no wall at the node
         scale = 1.0 + max(np.abs(gap[n][finite]).max(initial=0.0), np.abs(u_nu).max())

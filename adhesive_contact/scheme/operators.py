@@ -2,8 +2,9 @@
 
 The system is written in the nodal frames of Γ_C, ũ = Rᵀ u
 (:meth:`~adhesive_contact.fem.contact_boundary.ContactBoundary.rotation`), and
-restricted to the free dofs; the held dofs (never at Γ_C, never rotated)
-enter through the coupling block a_FD, built once per step matrix. Two step matrices serve the whole run
+restricted to the free dofs; the held dofs (at a contact node ũ = ±u
+there, the sign of R's diagonal; elsewhere not rotated) enter through the
+coupling block a_FD, built once per step matrix. Two step matrices serve the whole run
 (:mod:`adhesive_contact.scheme.condensed`):
 
 - a_n = A + k R(0) for n ≥ 1 (the j = n term of the right rectangle rule
@@ -28,6 +29,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..linear_solvers import choose, make_linear_solver
 from .condensed import CondensedOperator, PartialCondensation
@@ -59,6 +61,7 @@ class StepOperators:
     step: CondensedOperator      # A + k R(0), for n ≥ 1
     tensors: tuple               # (λ, μ) of A and of A + k R(0)
     support: tuple               # per tensor (a_FD (nF, nD), a_D· (nD, ndofs)), built once
+    held_sign: np.ndarray        # (nD,) ũ_D = held_sign g_D (±1 at a contact node, else 1)
     factor_seconds: float
     schur_seconds: float
     shift: object = None         # sparse D = a_n − A on the free dofs, when t = 0 iterates
@@ -103,6 +106,9 @@ class StepOperators:
             return solver
 
         fixed = problem.prescribed.fixed
+        # ũ_D = s g_D: R is ±1 on its diagonal at the held dofs (a held
+        # component of a contact node is ±u_h there, ContactBoundary.rotation)
+        sign = R.diagonal()[fixed] if R is not None else np.ones(fixed.size)
         support = {}   # (λ, μ) -> (a_FD, a_D·): the coupling and the held rows
 
         def frames(lam, mu):
@@ -112,7 +118,11 @@ class StepOperators:
         def coupled(lam, mu):
             """The matrix of (λ, μ) in frames, its coupling and held rows kept."""
             A = frames(lam, mu)
-            rows = A[fixed]     # the held dofs are not rotated: rows of a_n in Cartesian u
+            # s·(rows of Rᵀ a R at the held dofs) = rows of a R: (a u)_D from ũ, and
+            # a_FD s g_D = (those rows)_F ᵀ g_D, the force of the held values
+            rows = A[fixed]
+            if np.any(sign != 1.0):
+                rows = (sp.diags(sign) @ rows).tocsr()
             support[(lam, mu)] = (rows[:, free].T.tocsr(), rows)
             return A
 
@@ -154,7 +164,7 @@ class StepOperators:
         schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
         return cls(rotation=R, free=free, initial=initial, step=step,
                    tensors=(elastic, stepped), support=(support[elastic], support[stepped]),
-                   factor_seconds=time.perf_counter() - t0, schur_seconds=schur,
+                   held_sign=sign, factor_seconds=time.perf_counter() - t0, schur_seconds=schur,
                    shift=shift, contraction=rho)
 
     @property
@@ -179,12 +189,16 @@ class StepOperators:
         return self.support[0 if n == 0 else 1][0] @ g
 
     def reaction(self, n, u_frame, f):
-        """The nodal reactions r_D = (a_n u)_D − f_D of level n on the held
-        dofs: the force the support exerts on the body, from the whole
-        nodal-frame ũ (ndofs,) (the rows of Rᵀ a_n R at the unrotated held
-        dofs are those of a_n R) and the load f_D on the held dofs (the
-        memory history subtracted)."""
+        """(a_n u)_D − f_D of level n on the held dofs, from the whole
+        nodal-frame ũ (ndofs,) (the rows of a_n R at the held dofs) and the
+        load f_D on the held dofs (the memory history subtracted): the force
+        the support exerts on the body, with that of the contact laws along
+        a held component of a contact node."""
         return self.support[0 if n == 0 else 1][1] @ u_frame - f
+
+    def held_frames(self, g):
+        """ũ_D: the held values g_D (nD,) as components of ũ."""
+        return self.held_sign * g
 
     def to_frames(self, f):
         """A load vector (ndofs,) in nodal frames, restricted to the free dofs."""

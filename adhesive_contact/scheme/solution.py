@@ -81,8 +81,10 @@ class Solution:
         return self.contact_force[:, :, 1:].sum(axis=1)
 
     def gap_violation(self):
-        """max_a (u_ν − g) per level (−inf without a wall or contact nodes)."""
+        """max_a (u_ν − g) per level over the contact nodes whose u_ν is not
+        held (−inf without a wall or such nodes)."""
         gap = self.problem.gap
         if gap is None or gap.shape[1] == 0:
             return np.full(self.t.size, -np.inf)
-        return (self.normal_displacement - gap[:self.t.size]).max(axis=1)
+        excess = self.normal_displacement - gap[:self.t.size]
+        return np.where(self.problem.boundary.held[:, 0], -np.inf, excess).max(axis=1)

@@ -27,7 +27,8 @@ class State:
     beta: np.ndarray     # (nf,) β_n per contact facet
     z: np.ndarray        # the step's unknowns: contact unknowns (nodal frames) or all free dofs
     u: np.ndarray        # (ndofs,) u_n, Cartesian
-    frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes
+    frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes,
+                         # held ones included
     memory: object       # the run's memory history (adhesive_contact.scheme.memory)
 
 
@@ -42,11 +43,13 @@ class Level:
     stress: np.ndarray            # (ncells, d, d)
     stress_zz: np.ndarray         # (ncells,) plane strain σ_zz, or None in 3D
     contact_force: np.ndarray     # (nc, d) force of Γ_C on the body, nodal frames
+                                  # (0 at a held component: in the reaction)
     frame_displacement: np.ndarray  # (nc, d)
     on_wall: np.ndarray           # (nc,) bool
     stuck: np.ndarray             # (nc,) bool
     probes: np.ndarray            # (nprobes, d)
     reaction: np.ndarray          # (nD,) force of the support on the body per held dof
+                                  # (with the contact laws' force along it)
     iterations: int
     residual: float
 
@@ -61,7 +64,13 @@ class ContactStep:
 
     ``within = (positions, size)`` when the step unknowns are the free dofs
     (:mod:`.full_system`), the contact unknowns at ``positions`` among
-    them; by default they are the contact unknowns alone."""
+    them; by default they are the contact unknowns alone.
+
+    The held components of the contact nodes enter the contact terms at the
+    values of :meth:`hold`; the friction of a node with a free tangential
+    component has its kink (``kink_nodes`` the nodes of ``kink``), that of
+    a node whose tangential components are all held is part of the
+    reaction of its side."""
 
     def __init__(self, problem, within=None):
         boundary, nc, d = problem.boundary, problem.boundary.nodes.size, problem.dim
@@ -71,12 +80,29 @@ class ContactStep:
         self.unknowns = self.energy.unknowns
         self.size = self.energy.nz
         self.kink = None
+        self.kink_nodes = np.zeros(0, dtype=np.int64)
         self.seconds = 0.0   # spent in the step method, over all levels so far
         if problem.friction is not None:
             # every friction law gets its slip directions held (κ_a = 0 without a
-            # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ
-            tangential = self.unknowns[np.arange(problem.columns.size).reshape(nc, d)[:, 1:]]
-            self.kink = Kink(tangential, np.zeros(nc))
+            # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ.
+            # Its nodes: those with a free tangential component (−1 at a held one)
+            column = np.full(nc * d, -1)
+            column[problem.columns] = np.arange(problem.columns.size)
+            tangential = column.reshape(nc, d)[:, 1:]
+            self.kink_nodes = np.flatnonzero((tangential >= 0).any(axis=1))
+            tangential = tangential[self.kink_nodes]
+            index = np.where(tangential >= 0, self.unknowns[np.maximum(tangential, 0)], -1)
+            self.kink = Kink(index, np.zeros(self.kink_nodes.size))
+
+    def hold(self, prescribed):
+        """Use the held values g_D(t_n) (nD,) of the step from now on."""
+        boundary = self.problem.boundary
+        if not boundary.has_held:
+            return
+        values = boundary.held_values(prescribed)
+        self.energy.set_held(values)
+        if self.kink is not None and np.any(self.kink.tangential < 0):
+            self.kink.offset = values.reshape(boundary.held.shape)[self.kink_nodes, 1:]
 
     def minimise(self, S, c, beta, n, z0, tighter=1.0):
         """The step solve of (4.1) on the contact unknowns with β_n, by
@@ -84,8 +110,8 @@ class ContactStep:
         problem = self.problem
         self.energy.set_bonding(beta)
         if self.kink is not None:
-            self.kink.radius = self.energy.node_kink(problem.boundary.point_node,
-                                                     problem.boundary.nodes.size)
+            self.kink.radius = self.energy.node_kink(
+                problem.boundary.point_node, problem.boundary.nodes.size)[self.kink_nodes]
         solver = problem.scene.solver
         options = self.options(S)
         if solver.method in NEWTON:
@@ -175,6 +201,12 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     stress σ_n = C ε(u_n) + k R(0) ε(u_n) + history, the contact reactions
     and the reactions of the held dofs.
 
+    The force of Γ_C at a free component of a contact node is its reaction
+    in the frame equations (S z − c). At a held component the contact laws
+    act too (at the prescribed value), but their force there has no
+    equation: it is part of the reaction (a_n u)_D − f_D of the held dof,
+    and ``contact_force`` is 0 there, so that Σ_sides R + Σ_a R_a F_a + ∫ f = 0.
+
     Returns ``(level, u, frame_u, z, result)``; ``result`` is the
     :class:`~adhesive_contact.step_methods.StepResult` (None without Γ_C)."""
     history = known.history
@@ -184,6 +216,8 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     force = np.zeros((nc, d))
     on_wall = np.zeros(nc, dtype=bool)
     stuck = np.zeros(nc, dtype=bool)
+    if contact is not None:
+        contact.hold(known.prescribed)
     if n == 0 and operators.shift is not None:
         u_free, z, c, result = proximal_solve(step, operators.shift, contact, n, b, beta, z0,
                                               operators.contraction)
@@ -194,14 +228,15 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     if contact is not None:
         # the force of Γ_C on the body: its reaction in the frame equations
         force.reshape(-1)[problem.columns] = (step.S @ z - c)[contact.unknowns]
-        on_wall = result.on_wall[contact.unknowns][problem.normal_columns]
+        normal = problem.normal_columns
+        on_wall[problem.columns[normal] // d] = result.on_wall[contact.unknowns][normal]
         if contact.kink is not None and problem.friction.has_kink:
-            stuck = result.stuck
+            stuck[contact.kink_nodes] = result.stuck
     u_frame = np.zeros(problem.ndofs)
     u_frame[operators.free] = u_free
-    u_frame[problem.prescribed.fixed] = known.prescribed   # held dofs are never rotated
-    frame_u = u_frame[problem.boundary.dofs.ravel()] if nc else np.zeros(0)
+    u_frame[problem.prescribed.fixed] = operators.held_frames(known.prescribed)
     u = operators.from_frames(u_frame)
+    frame_u = problem.boundary.frame_components(u) if nc else np.zeros(0)
 
     lam, mu = operators.tensor(n)
     a_lam, a_mu = lam * u, mu * u

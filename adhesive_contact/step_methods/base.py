@@ -83,10 +83,43 @@ OPTIMIZER_ITERATIONS = 100
 
 @dataclass
 class Kink:
-    """The nodes whose friction has a kink: their tangential unknowns and κ_a."""
+    """The nodes whose friction has a kink: their tangential unknowns and κ_a.
 
-    tangential: np.ndarray   # (na, m) indices into z
+    ξ_a = z[tangential[a]] + offset[a]: a tangential component the
+    boundary holds (at a node of a 3D Γ_C whose other tangential component
+    is free) has the index −1 and its held value in ``offset``; ``offset``
+    is None when no component is held. Read and write the tangential
+    unknowns with :meth:`take` and :meth:`put`, which skip the held ones."""
+
+    tangential: np.ndarray   # (na, m) indices into z, −1 for a held component
     radius: np.ndarray       # (na,) κ_a ≥ 0
+    offset: np.ndarray = None  # (na, m) held values (0 at the unknowns), or None
+
+    def __post_init__(self):
+        unknown = self.tangential >= 0
+        self._unknown = None if unknown.all() else unknown
+        self._index = np.where(unknown, self.tangential, 0)
+
+    def take(self, v):
+        """v at the tangential unknowns (na, m), 0 at the held components."""
+        if self._unknown is None:
+            return v[self.tangential]
+        return np.where(self._unknown, v[self._index], 0)
+
+    def xi(self, z):
+        """ξ_a (na, m), held components included."""
+        out = self.take(z)
+        return out if self.offset is None else out + self.offset
+
+    def put(self, v, rows, values):
+        """v[tangential[rows]] = values[rows] (values (na, m) or a scalar)
+        at the tangential unknowns of the nodes ``rows`` (a bool mask)."""
+        values = np.broadcast_to(values, self.tangential.shape)
+        if self._unknown is None:
+            v[self.tangential[rows]] = values[rows]
+            return
+        keep = self._unknown[rows]
+        v[self.tangential[rows][keep]] = values[rows][keep]
 
 
 def no_kink():
@@ -133,17 +166,17 @@ def stationarity(S, c, energy, upper, z, kink):
     Sz = S @ z
     gphi = energy.gradient(z)
     g = Sz - c + gphi
-    xi = z[tan] if tan.size else np.zeros((0, 0))
+    xi = kink.xi(z) if tan.size else np.zeros((0, 0))
     s = np.linalg.norm(xi, axis=1)
     at_zero = s == 0
     unit = np.where(at_zero[:, None], 0.0, xi / np.where(at_zero, 1.0, s)[:, None])
-    h = (g[tan] if tan.size else np.zeros((0, 0))) - kappa[:, None] * unit
+    h = (kink.take(g) if tan.size else np.zeros((0, 0))) - kappa[:, None] * unit
     hn = np.linalg.norm(h, axis=1)
     pg = g.copy()
     wall = np.isfinite(upper) & (z >= upper) & (g < 0)
     pg[wall] = 0.0
     if tan.size:
-        pg[tan[at_zero]] = kink_subgradient(h, kappa)[at_zero]
+        kink.put(pg, at_zero, kink_subgradient(h, kappa))
     scale = max(np.abs(c).max(initial=0.0), np.abs(Sz).max(initial=0.0),
                 np.abs(gphi).max(initial=0.0), kappa.max(initial=0.0), 1e-300)
     return Stationarity(g=g, Sz=Sz, xi=xi, s=s, at_zero=at_zero, unit=unit, h=h, hn=hn, pg=pg,

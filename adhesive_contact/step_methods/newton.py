@@ -128,8 +128,8 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         fixed = binding.copy()
         d = np.zeros(nz)
         if tan.size:
-            fixed[tan[stuck]] = True
-            d[tan[stuck]] = -xi[stuck]
+            kink.put(fixed, stuck, True)
+            kink.put(d, stuck, -xi)
         zmax = np.abs(zc).max(initial=0.0)
         Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)   # sparse, nodal blocks
         d[binding] = upper[binding] - z[binding]   # onto the wall
@@ -148,30 +148,28 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         ref = unit.copy()
         if tan.size:
             start = at_zero & ~stuck
-            ref[start] = -pg[tan[start]] / np.maximum(
-                np.linalg.norm(pg[tan[start]], axis=1), 1e-300)[:, None]
+            pg_tan = kink.take(pg)[start]
+            ref[start] = -pg_tan / np.maximum(np.linalg.norm(pg_tan, axis=1), 1e-300)[:, None]
             # a node leaving ξ = 0 moves along its held direction only: the
             # coupled Newton step may point it elsewhere (in 3D), and a slip
             # off the direction of −h meets a friction force of size κ_a in
             # the wrong direction; the next step turns it back to 0, and
             # with a flat energy the two iterates alternate for ever
-            along = np.maximum(np.sum(d[tan[start]] * ref[start], axis=1), 0.0)
-            d[tan[start]] = along[:, None] * ref[start]
+            along = np.maximum(np.sum(kink.take(d) * ref, axis=1), 0.0)
+            kink.put(d, start, along[:, None] * ref)
 
         def project(trial):
             trial = np.minimum(trial, upper)
             if tan.size:
-                txi = trial[tan]
-                turned = np.sum(txi * ref, axis=1) <= 0   # stuck nodes reach 0 at α = 1
-                txi[turned] = 0.0
-                trial[tan] = txi
+                turned = np.sum(kink.xi(trial) * ref, axis=1) <= 0   # stuck nodes reach 0 at α = 1
+                kink.put(trial, turned, 0.0)
             return trial
 
         def slope(step):
             # E'(z; step): the kink adds κ |Δξ| at nodes where ξ = 0
             out = g @ step
             if tan.size:
-                out += kappa[at_zero] @ np.linalg.norm(step[tan[at_zero]], axis=1)
+                out += kappa[at_zero] @ np.linalg.norm(kink.take(step)[at_zero], axis=1)
             return out
 
         # the Newton direction, else (nonconvex energy, far from the
@@ -179,7 +177,7 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         slack = noise(z, st.Sz)
         gradient_step = -pg / np.where(diag_S > 0, diag_S, 1.0)
         if tan.size:
-            gradient_step[tan[stuck]] = -xi[stuck]
+            kink.put(gradient_step, stuck, -xi)
         if not globalised:
             trial = project(z + d)
             E_trial = total(trial)

@@ -44,10 +44,10 @@ def minimise(S, c, energy, upper, z0, options, kink=None):
         g = Sz - c + energy.gradient(z)
         if tan.size:
             # the kink's subgradient of minimal norm where ξ_a = 0
-            xi = z[tan]
+            xi = kink.xi(z)
             zero = ~np.any(xi != 0, axis=1)
             if zero.any():
-                g[tan[zero]] = kink_subgradient(g[tan[zero]], kink.radius[zero])
+                kink.put(g, zero, kink_subgradient(kink.take(g), kink.radius))
         return E, g
 
     bounds = [(None, None if not np.isfinite(b) else float(b)) for b in upper]

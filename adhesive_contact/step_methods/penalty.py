@@ -49,15 +49,13 @@ class SmoothedContact:
         return np.where(self.bounded, np.maximum(z - self.bound, 0.0), 0.0)
 
     def _friction(self, z):
-        e = self.energy
-        xi = np.stack([t @ z for t in e.T], axis=-1)
+        xi = self.energy.tangential(z)
         s = np.linalg.norm(xi, axis=-1)
         r = np.sqrt(s * s + self.delta * self.delta)
         return xi, s, r, r - self.delta
 
     def _normal(self, z):
-        e = self.energy
-        return e.N @ z
+        return self.energy.normal(z)
 
     def value(self, z):
         e, out = self.energy, 0.0
@@ -142,7 +140,7 @@ def minimise(S, c, energy, upper, z0, options, kink=None, sigma=1e-4):
             break
         z, E = accepted
     violation = phi._violation(z)
-    s = np.linalg.norm(z[kink.tangential], axis=1) if kink.tangential.size else np.zeros(0)
+    s = np.linalg.norm(kink.xi(z), axis=1) if kink.tangential.size else np.zeros(0)
     message = MESSAGES[status].format(max_iter=options.max_iter, nit=it)
     if inner_failures:
         message += f" ({inner_failures} Newton systems solved inexactly)"
