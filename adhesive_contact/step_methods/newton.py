@@ -10,7 +10,14 @@ with Φ the contact terms (:class:`~adhesive_contact.scheme.contact_energy.Conta
 Friction laws with a kink at ξ = 0 (Tresca, slip weakening) add, at each
 contact node a, a term with Clarke subdifferential B(0, κ_a) at ξ_a = 0.
 
-The method is a projected semismooth Newton iteration with an Armijo line
+Each iteration first tries the semismooth Newton step of
+:func:`semismooth_step` on the projection form of the optimality
+conditions (the min function for the wall, the shrink operator for the
+kink), whose sets follow the iterate coordinate by coordinate and whose
+slip directions may turn inside a step; its trial points must pass the
+same Armijo test. When none does, the iteration is the held-direction
+one below (and "newton-plain" uses only that one): a projected semismooth
+Newton iteration with an Armijo line
 search on E, combining Bertsekas' two-metric projection for the wall with
 the orthant-wise treatment of the kink (as in OWL-QN):
 

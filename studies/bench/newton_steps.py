@@ -16,8 +16,9 @@ dofs, 50 steps; the 3D block, 1.09e5 dofs, 20 steps), run in-process with
 - the share of the step method's seconds (``timings.contact_solve``) in
   the Newton systems (``newton_solve``: factorisations and solves, minus
   the AMG hierarchy's updates), in those updates, in the Hessian of Φ,
-  in products with the step matrix, in the line search (energy values
-  along the trial points, products excluded) and in the residual
+  in products with the step matrix, in the line search and the sets
+  (energy values along the trial points, the set identification, products
+  excluded) and in the residual
   (pseudo-gradient, products excluded): exclusive times of wrapped
   functions, the rest "other".
 
@@ -91,6 +92,8 @@ def instrument(profile):
     profile.wrap(condensed.RememberedProduct, "__matmul__", "products")
     profile.wrap(condensed.ImplicitSchur, "__matmul__", "products")
     profile.wrap(newton, "backtrack", "line_search")
+    if hasattr(newton, "semismooth_step"):   # its sets and its line search
+        profile.wrap(newton, "semismooth_step", "line_search")
     profile.wrap(newton, "stationarity", "residual")
     for name in ("update_factor", "bordered_solve"):   # factor updates, where the code has them
         for cls in (condensed.DenseSchur,):
