@@ -206,3 +206,66 @@ def test_unknown_method_and_bad_penalty_are_refused():
         scene_from_dict(scene("penalty", penalty=-1.0))
     with pytest.raises(SceneError, match=r"^solver\.smoothing: must be > 0, got 0$"):
         scene_from_dict(scene("penalty", smoothing=0.0))
+
+
+class TrescaNode:
+    """Φ(ξ) = κ |ξ| on one node's tangential unknowns ξ ∈ R^m (z = ξ): the
+    contact terms of a Tresca node, for closed-form step problems."""
+
+    def __init__(self, kappa, m):
+        self.kappa, self.unknowns = kappa, np.arange(m)
+
+    def value(self, z):
+        return self.kappa * np.linalg.norm(z)
+
+    def gradient(self, z):
+        s = np.linalg.norm(z)
+        return self.kappa * z / s if s > 0 else np.zeros_like(z)
+
+    def hessian(self, z, s_floor=0.0, kink_free=False):
+        import scipy.sparse as sp
+        m, s = z.size, max(np.linalg.norm(z), s_floor)
+        if kink_free or m == 1 or s == 0:
+            return sp.csr_matrix((m, m))
+        e = z / s
+        return sp.csr_matrix(self.kappa / s * (np.eye(m) - np.outer(e, e)))
+
+
+def tresca_step(m, c, z0, **options):
+    """min ½ s|ξ|² − cᵀξ + κ|ξ| (s = 4, κ = 1) from z0: its closed form
+    ξ* = (|c| − κ)₊/s ĉ, and the "newton" result."""
+    from adhesive_contact.scheme.condensed import DenseSchur
+    from adhesive_contact.step_methods import Kink
+
+    s, kappa, c = 4.0, 1.0, np.asarray(c, dtype=float)
+    exact = max(np.linalg.norm(c) - kappa, 0.0) / s * c / np.linalg.norm(c)
+    result = minimise_step(DenseSchur(s * np.eye(m)), c, TrescaNode(kappa, m), np.full(m, np.inf),
+                           np.asarray(z0, dtype=float), tol=1e-12,
+                           kink=Kink(np.arange(m)[None, :], np.array([kappa])), **options)
+    return exact, result
+
+
+def test_a_slip_direction_turns_within_one_newton_iteration():
+    """2D: a node slipping forwards (ξ0 > 0) whose load now drives it
+    backwards: the semismooth step reaches ξ* = (c + κ)/s < 0 in one
+    iteration (the energy is quadratic on each side of the kink); holding
+    the direction for the step first stops the node at 0."""
+    exact, result = tresca_step(1, [-3.0], [0.3])
+    assert result.success and result.nit == 1
+    assert abs(result.z[0] - exact[0]) <= 1e-14
+    _, held = tresca_step(1, [-3.0], [0.3], semismooth=False)
+    assert held.success and held.nit >= 2
+    assert abs(held.z[0] - exact[0]) <= 1e-14
+
+
+@pytest.mark.parametrize("c, z0", [([3.0, 0.0], [0.0, 0.4]),     # slipping across: turns 90°
+                                   ([-3.0, 1.0], [0.5, 0.1]),    # nearly reversed
+                                   ([0.6, 0.5], [0.2, -0.3])])   # |c| < κ: it must stick
+def test_a_3d_slip_direction_turns_to_the_closed_form(c, z0):
+    """3D (two tangential unknowns): from a slip at an angle to the load,
+    the step converges to the closed form of the Tresca node, and a node
+    whose load is inside the friction bound ends stuck (ξ = 0 exactly)."""
+    exact, result = tresca_step(2, c, z0)
+    assert result.success and result.nit <= 6
+    assert np.abs(result.z - exact).max() <= 1e-12
+    assert bool(result.stuck[0]) == (np.linalg.norm(c) <= 1.0)

@@ -112,13 +112,18 @@ class ContactEnergy:
                 g += t.T @ force[:, i]
         return g
 
-    def hessian(self, z, s_floor=0.0):
+    def hessian(self, z, s_floor=0.0, kink_free=False):
         """Sparse (nz, nz); ``s_floor`` bounds |ξ| from below in φ''.
 
         H = Nᵀ diag(w p_ν') N + Σ_ij T_iᵀ diag(w b_ij) T_j, with b the
         point blocks of the friction Hessian in the module doc, entered
         through :class:`HessianMap` (one sparse product, no sparse algebra
-        per call)."""
+        per call). With ``kink_free`` it is the Hessian of Φ − Σ_q w_q
+        φ'(β_q, 0+) |ξ_q|, the contact terms without the kink's cone (the
+        smooth part F of the semismooth step method,
+        :mod:`adhesive_contact.step_methods.newton`): the tangential
+        curvature (φ'(|ξ|) − φ'(0+))/|ξ| (I − ξ̂ξ̂ᵀ) in place of
+        φ'/|ξ| (I − ξ̂ξ̂ᵀ), bounded as ξ → 0 (the same in 2D)."""
         normal = blocks = None
         if self.normal_law.active:
             normal = self.w * self.normal_law.derivative(self.beta, self.normal(z))
@@ -133,8 +138,10 @@ class ContactEnergy:
             else:
                 e = np.where(s[:, None] > 0, xi / np.where(s > 0, s, 1.0)[:, None], 0.0)
                 ee = e[:, :, None] * e[:, None, :]
-                tang = np.where(s > 0, self.friction.dphi(self.beta, sf)
-                                / np.where(sf > 0, sf, 1.0), 0.0)
+                slope = self.friction.dphi(self.beta, sf)
+                if kink_free:
+                    slope = slope - self.friction.kink(self.beta)
+                tang = np.where(s > 0, slope / np.where(sf > 0, sf, 1.0), 0.0)
                 blocks = (dd[:, None, None] * np.where(s[:, None, None] > 0, ee, np.eye(m))
                           + tang[:, None, None] * (np.eye(m) - ee))
             blocks = self.w[:, None, None] * blocks

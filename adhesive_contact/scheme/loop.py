@@ -79,7 +79,8 @@ def march(problem, operators, contact, recorder, state, progress=None):
         failure = check_load(n, t, b)
         if failure is None:
             level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
-                                                      beta, history, state.z)   # (4.1)
+                                                      beta, history, state.z,
+                                                      state.z_before)           # (4.1)
             failure = StepFailure(n, t, result) if level is None else check_level(problem,
                                                                                   level)
             if failure is not None and failure.result is None:
@@ -89,7 +90,8 @@ def march(problem, operators, contact, recorder, state, progress=None):
         recorder.record(level)
         if n >= 1:
             state.memory.advance(n, u)
-        state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=state.memory)
+        state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=state.memory,
+                      z_before=state.z if n >= 1 else None)
         if progress is not None and progress(n, problem.scene.steps) is True:
             return (STOPPED if n < problem.scene.steps else SUCCESS), None, state
     return SUCCESS, None, state

@@ -30,6 +30,7 @@ class State:
     frame_u: np.ndarray  # (nc·d,) all nodal-frame components of u_n at the contact nodes,
                          # held ones included
     memory: object       # the run's memory history (adhesive_contact.scheme.memory)
+    z_before: np.ndarray = None   # the step's unknowns of level n − 1 (None before level 1)
 
 
 @dataclass
@@ -104,9 +105,12 @@ class ContactStep:
         if self.kink is not None and np.any(self.kink.tangential < 0):
             self.kink.offset = values.reshape(boundary.held.shape)[self.kink_nodes, 1:]
 
-    def minimise(self, S, c, beta, n, z0, tighter=1.0):
+    def minimise(self, S, c, beta, n, z0, tighter=1.0, before=None):
         """The step solve of (4.1) on the contact unknowns with β_n, by
-        ``solver.method``; a Newton method's tolerance times ``tighter``."""
+        ``solver.method``; a Newton method's tolerance times ``tighter``.
+        ``z0`` is the last level's solution; with ``before``, the one of
+        the level before it, the "newton" method starts from the
+        :meth:`predictor` where that lowers the step energy."""
         problem = self.problem
         self.energy.set_bonding(beta)
         if self.kink is not None:
@@ -119,9 +123,33 @@ class ContactStep:
         upper = np.full(self.size, np.inf)
         upper[self.unknowns] = problem.upper_bound(n)
         start = time.perf_counter()
+        if before is not None and solver.method == "newton":
+            z0 = self.predictor(S, c, upper, z0, before, n)
         result = minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
         self.seconds += time.perf_counter() - start
         return result
+
+    def predictor(self, S, c, upper, last, before, n):
+        """The start of step n from the last two levels: z_{n−1} + (z_{n−1}
+        − z_{n−2}) (uniform steps), with the sets of level n − 1 kept
+        (a node stuck there, ξ = 0, stays stuck; one on the wall of t_{n−1}
+        is put on the wall of t_n) and projected onto the wall; z_{n−1}
+        itself where the extrapolation does not lower the step energy
+        ½ zᵀ S z − cᵀ z + Φ(z) (β_n, the load of level n)."""
+        guess = 2.0 * last - before
+        positions = self.unknowns
+        wall_before = self.problem.upper_bound(n - 1)
+        held = np.isfinite(wall_before) & (last[positions] >= wall_before)
+        guess[positions[held]] = upper[positions[held]]
+        if self.kink is not None:
+            stuck = ~np.any(self.kink.xi(last) != 0, axis=1)
+            self.kink.put(guess, stuck, 0.0)
+        guess = np.minimum(guess, upper)
+        start = np.minimum(last, upper)
+
+        def energy(z):
+            return 0.5 * z @ (S @ z) - c @ z + self.energy.value(z)
+        return guess if energy(guess) < energy(start) else start
 
     def options(self, S):
         """The StepOptions of a step with matrix S: the scene's tolerances and,
@@ -195,7 +223,7 @@ def step_load(problem, operators, state, n, t):
     return b, KnownPart(history, g, f[held.fixed])
 
 
-def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
+def step_solve(problem, operators, contact, n, t, b, beta, known, z0, z_before=None):
     """(4.1) at level n: the nonsmooth problem on the contact unknowns, then
     the interior by back substitution, the held values g_D(t_n) put in, the
     stress σ_n = C ε(u_n) + k R(0) ε(u_n) + history, the contact reactions
@@ -206,6 +234,9 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     act too (at the prescribed value), but their force there has no
     equation: it is part of the reaction (a_n u)_D − f_D of the held dof,
     and ``contact_force`` is 0 there, so that Σ_sides R + Σ_a R_a F_a + ∫ f = 0.
+
+    ``z0`` the step unknowns of level n − 1, ``z_before`` those of level
+    n − 2 (for the predictor of :meth:`ContactStep.predictor`), or None.
 
     Returns ``(level, u, frame_u, z, result)``; ``result`` is the
     :class:`~adhesive_contact.step_methods.StepResult` (None without Γ_C)."""
@@ -222,7 +253,7 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
         u_free, z, c, result = proximal_solve(step, operators.shift, contact, n, b, beta, z0,
                                               operators.contraction)
     else:
-        u_free, z, c, result = free_solve(step, contact, n, b, beta, z0)
+        u_free, z, c, result = free_solve(step, contact, n, b, beta, z0, before=z_before)
     if u_free is None:
         return None, None, None, z0, result
     if contact is not None:
@@ -255,7 +286,7 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0):
     return level, u, frame_u, z, result
 
 
-def free_solve(step, contact, n, b, beta, z0, tighter=1.0):
+def free_solve(step, contact, n, b, beta, z0, tighter=1.0, before=None):
     """The free dofs of (4.1) with the condensed step matrix ``step`` and
     the load b: the contact problem on z, then the interior by back
     substitution. Returns ``(u_free, z, c, result)``, u_free None when the
@@ -263,7 +294,7 @@ def free_solve(step, contact, n, b, beta, z0, tighter=1.0):
     c = step.reduce(b)
     result, z = None, z0
     if contact is not None:
-        result = contact.minimise(step.S, c, beta, n, z0, tighter)
+        result = contact.minimise(step.S, c, beta, n, z0, tighter, before)
         if not result.success:
             return None, z0, c, result
         z = result.z

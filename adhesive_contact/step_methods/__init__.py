@@ -8,9 +8,12 @@
 
 chosen by the scene's ``solver.method``:
 
-- ``"newton"`` (:mod:`.newton`, the default): projected semismooth Newton,
+- ``"newton"`` (:mod:`.newton`, the default): semismooth Newton on the
+  projection form of the step (sets free to move, slip directions free to
+  turn), with the held-direction projected Newton step as its fallback,
   globalised by an Armijo line search with a gradient fallback;
-- ``"newton-plain"`` (:mod:`.newton_plain`): the same with full steps only;
+- ``"newton-plain"`` (:mod:`.newton_plain`): the held-direction step with
+  full steps only;
 - ``"penalty"`` (:mod:`.penalty`): the wall as a penalty ρ, the friction
   kink smoothed over δ, Newton on the smooth energy: solves a nearby
   problem and reports the wall violation it leaves;

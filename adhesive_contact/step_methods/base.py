@@ -100,6 +100,11 @@ class Kink:
         self._unknown = None if unknown.all() else unknown
         self._index = np.where(unknown, self.tangential, 0)
 
+    @property
+    def held(self):
+        """Whether some node has a held tangential component (index −1)."""
+        return self._unknown is not None
+
     def take(self, v):
         """v at the tangential unknowns (na, m), 0 at the held components."""
         if self._unknown is None:

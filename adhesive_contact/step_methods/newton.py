@@ -10,7 +10,14 @@ with Φ the contact terms (:class:`~adhesive_contact.scheme.contact_energy.Conta
 Friction laws with a kink at ξ = 0 (Tresca, slip weakening) add, at each
 contact node a, a term with Clarke subdifferential B(0, κ_a) at ξ_a = 0.
 
-The method is a projected semismooth Newton iteration with an Armijo line
+Each iteration first tries the semismooth Newton step of
+:func:`semismooth_step` on the projection form of the optimality
+conditions (the min function for the wall, the shrink operator for the
+kink), whose sets follow the iterate coordinate by coordinate and whose
+slip directions may turn inside a step; its trial points must pass the
+same Armijo test. When none does, the iteration is the held-direction
+one below (and "newton-plain" uses only that one): a projected semismooth
+Newton iteration with an Armijo line
 search on E, combining Bertsekas' two-metric projection for the wall with
 the orthant-wise treatment of the kink (as in OWL-QN):
 
@@ -44,6 +51,7 @@ grows past 1e8 times the size of the first one.
 """
 
 import numpy as np
+import scipy.sparse as sp
 
 from .base import (
     CONVERGED,
@@ -68,7 +76,7 @@ def minimise(S, c, energy, upper, z0, options, kink=None):
 
 
 def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, sigma=1e-4,
-                  globalised=True):
+                  globalised=True, semismooth=None):
     """Minimise ½ zᵀSz − cᵀz + Φ(z) subject to z ≤ upper (see module doc).
 
     Parameters
@@ -88,7 +96,11 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     kink : Kink or None
     globalised : False for the full projected Newton step every iteration
         (no line search, no gradient fallback)
+    semismooth : try the semismooth Newton step of :func:`semismooth_step`
+        first at every iteration (default: when ``globalised``)
     """
+    if semismooth is None:
+        semismooth = globalised
     nz = c.size
     bounded = np.isfinite(upper)
     if kink is None:
@@ -119,6 +131,19 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         if status is not None:
             break
 
+        forcing = eisenstat_walker(residual, last_residual) if globalised else 1e-12
+        if semismooth:
+            # the semismooth Newton step, its sets free to change; when its
+            # line search fails, the held-direction iteration below
+            accepted, solved = semismooth_step(S, energy, upper, z, E, st, kink,
+                                               (forcing, 0.5 * tol * scale),
+                                               total, noise(z, st.Sz), sigma)
+            inner_failures += not solved
+            if accepted is not None:
+                z, E = accepted
+                last_residual = residual
+                continue
+
         # identify the sets with a projected-gradient step length ε
         zc = z[contact]
         width = np.abs(zc - np.minimum(zc - pg[contact] / diag_S[contact],
@@ -138,7 +163,6 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             moved = np.where(fixed, d, 0.0)
             rhs = -pg[free] - ((S @ moved)[free] + (Hphi @ moved)[free])
             # inexact directions need the line search: full steps get exact ones
-            forcing = eisenstat_walker(residual, last_residual) if globalised else 1e-12
             d[free], converged = S.newton_solve(Hphi, rhs, free,
                                                 accuracy=(forcing, 0.5 * tol * scale))
             inner_failures += not converged
@@ -204,6 +228,114 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
                       residual=residual / scale, tolerance=tol, energy=E,
                       inner_failures=inner_failures, multiplier=np.where(wall, -g, 0.0),
                       on_wall=wall, stuck=at_zero)
+
+
+def semismooth_step(S, energy, upper, z, E, st, kink, accuracy, total, slack, sigma,
+                    halvings=10):
+    """One semismooth Newton step on the projection form of the step's
+    optimality conditions, with an Armijo line search on E.
+
+    Write E = F + Σ_a κ_a |ξ_a| + (the wall), F the smooth part (the
+    contact terms without the kinks' cones: ∇_a F = h_a, the tangential
+    gradient without the kink, ∂²F of ``energy.hessian(kink_free=True)``).
+    z is stationary when, with a step length γ_i = 1/(S + ∂²F)_ii per
+    coordinate (γ_a the smallest of a node's),
+
+        z_ν = min(g_ν, z_ν − γ ∂_ν F)          (the wall, the min function),
+        ξ_a = shrink(ξ_a − γ_a h_a, γ_a κ_a)   (the kink, shrink(w, t) = w (1 − t/|w|)₊),
+
+    and ∂_i F = 0 elsewhere. Newton on these piecewise smooth equations
+    takes the sets from the current z, each coordinate on its own (not
+    from z's distance to the wall or to ξ = 0, as the held-direction
+    iteration does): on the wall where z_ν − γ ∂_ν F ≥ g (then
+    d_ν = g − z_ν); stuck where |w_a| ≤ γ_a κ_a, w_a = ξ_a − γ_a h_a (then
+    d_a = −ξ_a); else the node slips along ŵ_a = w_a/|w_a|, which may turn
+    against ξ_a, and its rows are (J the Jacobian of shrink at w_a)
+
+        (∂²F d)_a + κ_a/(|w_a| − γ_a κ_a) (I − ŵ_a ŵ_aᵀ) d_a = −J⁻¹ (h_a + κ_a ŵ_a),
+
+    J⁻¹ = ŵŵᵀ + |w|/(|w| − γκ) (I − ŵŵᵀ): symmetric, and at a slipping
+    solution (|w| − γκ = |ξ|) the Hessian of κ|ξ|. Nodes with κ_a = 0 are
+    smooth coordinates. The trial points z + αd, with the held
+    coordinates put on the wall or at ξ = 0, α = 1, ½, … (``halvings``
+    times), are accepted by the Armijo test of the module doc.
+
+    A node with a held tangential component (3D, a vertex on a side that
+    holds one tangential direction: ``kink.held``) has no projection form
+    here: with such nodes the step is not taken (None, True) and the
+    held-direction iteration does the work.
+
+    Returns ``(accepted, solved)``: ``accepted`` (z, E) or None when no
+    trial passed, ``solved`` False when the Newton system was solved
+    inexactly."""
+    if kink.held:
+        return None, True
+    tan, kappa = kink.tangential, kink.radius
+    g = st.g
+    zmax = np.abs(z[energy.unknowns]).max(initial=0.0)
+    floor = 1e-12 + 1e-8 * zmax
+    H = energy.hessian(z, s_floor=floor, kink_free=True).tocsr()
+    diagonal = S.diagonal() + H.diagonal()
+    gamma = 1.0 / np.where(diagonal > 0, diagonal, np.maximum(S.diagonal(), 1e-300))
+    wall = np.isfinite(upper) & (z - gamma * g >= upper)
+    d = np.zeros(z.size)
+    d[wall] = upper[wall] - z[wall]
+    fixed = wall.copy()
+    rhs = -g
+    stick = np.zeros(tan.shape[0], dtype=bool)
+    if tan.size:
+        xi, h = st.xi, st.h
+        m = tan.shape[1]
+        step = gamma[tan].min(axis=1)
+        w = xi - step[:, None] * h
+        wn = np.linalg.norm(w, axis=1)
+        kinked = kappa > 0
+        stick = kinked & (wn <= step * kappa)
+        slip = kinked & ~stick
+        fixed[tan[stick]] = True
+        d[tan[stick]] = -xi[stick]
+        what = w[slip] / wn[slip][:, None]
+        r = h[slip] + kappa[slip, None] * what
+        if m > 1:
+            # J⁻¹ r and the cone's curvature across ŵ (3D)
+            excess = np.maximum(wn[slip] - step[slip] * kappa[slip], floor)
+            along = np.sum(r * what, axis=1)[:, None] * what
+            r = along + (wn[slip] / excess)[:, None] * (r - along)
+            across = (kappa[slip] / excess)[:, None, None] * (
+                np.eye(m) - what[:, :, None] * what[:, None, :])
+            rows = np.repeat(tan[slip], m, axis=1).ravel()
+            cols = np.tile(tan[slip], (1, m)).ravel()
+            H = H + sp.csr_matrix((across.ravel(), (rows, cols)), shape=H.shape)
+        rhs = rhs.copy()
+        rhs[tan[slip]] = -r
+    free = ~fixed
+    solved = True
+    if free.any():
+        moved = np.where(fixed, d, 0.0)
+        right = rhs[free] - ((S @ moved)[free] + (H @ moved)[free])
+        d[free], solved = S.newton_solve(H, right, free, accuracy=accuracy)
+
+    def project(trial):
+        trial = np.minimum(trial, upper)
+        trial[wall] = upper[wall]
+        if tan.size:
+            trial[tan[stick]] = 0.0
+        return trial
+
+    at_zero = st.at_zero
+    alpha = 1.0
+    for _ in range(halvings):
+        trial = project(z + alpha * d)
+        change = trial - z
+        slope = g @ change
+        if tan.size:
+            slope += kappa[at_zero] @ np.linalg.norm(change[tan[at_zero]], axis=1)
+        if slope < 0:
+            E_trial = total(trial)
+            if E_trial <= E + sigma * slope + slack:
+                return (trial, E_trial), solved
+        alpha *= 0.5
+    return None, solved
 
 
 def eisenstat_walker(residual, last, gamma=0.9, largest=0.1):
