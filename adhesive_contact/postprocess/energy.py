@@ -33,12 +33,13 @@ nodes. Its terms:
   splits into the debonding release at the old displacement and a Bregman
   remainder at the new bonding,
 
-      D^b_n = Φ(β_{n−1}, z_{n−1}) − Φ(β_n, z_{n−1})               (debonding, ≥ 0 as β falls)
-      B_n   = Φ(β_n, z_{n−1}) − Φ(β_n, z_n) − F_n·(z_{n−1} − z_n)·(−1) ... (numerical)
+      D^b_n = Φ(β_{n−1}, z_{n−1}) − Φ(β_n, z_{n−1})    (debonding, ≥ 0 as β falls)
+      B_n   = Φ(β_n, z_{n−1}) − Φ(β_n, z_n) + F_n·(z_{n−1} − z_n) − W^wall_n
+                                                      (numerical, with N_n)
 
-  precisely B_n = Φ(β_n, z_{n−1}) − Φ(β_n, z_n) + F_n·(z_{n−1} − z_n) − W^wall_n,
-  ≥ 0 for convex laws since −F_n is a subgradient of Φ(β_n, ·) plus the
-  wall at z_n.
+  B_n ≥ 0 for convex laws, since −F_n is a subgradient at z_n of Φ(β_n, ·)
+  plus the wall's constraint; W^wall_n = −λ_n·(g_n − g_{n−1}) is the work
+  of a wall that moves (λ_n its multiplier), 0 for a fixed one.
 
 The stored parts are named by what holds them: ``elastic`` (½|ε|²_{C̃∞}),
 ``memory`` (the branches), ``layer`` (Φ at β = 0 of the normal law: the
