@@ -34,7 +34,7 @@ nodes. Its terms:
   remainder at the new bonding,
 
       D^b_n = Φ(β_{n−1}, z_{n−1}) − Φ(β_n, z_{n−1})    (debonding, ≥ 0 as β falls)
-      B_n   = Φ(β_n, z_{n−1}) − Φ(β_n, z_n) + F_n·(z_{n−1} − z_n) − W^wall_n
+      B_n   = Φ(β_n, z_{n−1}) − Φ(β_n, z_n) + F_n·(z_{n−1} − z_n) + W^wall_n
                                                       (numerical, with N_n)
 
   B_n ≥ 0 for convex laws, since −F_n is a subgradient at z_n of Φ(β_n, ·)
@@ -258,7 +258,7 @@ def contact_energies(solution):
             normal = np.arange(0, z.shape[0], problem.dim)
             lam = -(force + potentials.law_force(beta, z))[normal].T * solution.on_wall
             wall = -np.sum(lam * dg, axis=1)
-    bregman = at_old - (layer + glue + friction) + np.sum(force * (z_old - z), axis=0) - wall
+    bregman = at_old - (layer + glue + friction) + np.sum(force * (z_old - z), axis=0) + wall
     return layer, glue, friction, debonding, bregman, wall
 
 

@@ -6,6 +6,7 @@ import matplotlib.pyplot as plt
 
 from .beta import plot_beta
 from .contact_map import plot_contact_map
+from ..postprocess import energies
 from .debonding import plot_debonding
 from .deformed import plot_deformed
 from .energy import plot_energy
@@ -52,8 +53,10 @@ def write_plots(solution, folder, failures=None):
         plots.append(("beta.png", plot_beta))
         if solution.problem.dim == 3:
             plots.append(("contact_map.png", plot_contact_map))
-    from ..postprocess import energies
-
+    curves = load_curves(solution)
+    if curves:
+        plots.append(("load_displacement.png",
+                      lambda solution, path: plot_load_displacement(solution, path, curves)))
     history = energies(solution)
     if history is not None:
         plots.append(("energy.png", lambda solution, path: plot_energy(solution, path, history)))
@@ -61,10 +64,6 @@ def write_plots(solution, folder, failures=None):
             and solution.problem.bonding is not None):
         plots.append(("debonding.png",
                       lambda solution, path: plot_debonding(solution, path, history)))
-    curves = load_curves(solution)
-    if curves:
-        plots.append(("load_displacement.png",
-                      lambda solution, path: plot_load_displacement(solution, path, curves)))
     names = []
     for name, plot in plots:
         before = set(plt.get_fignums())
