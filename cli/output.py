@@ -33,7 +33,7 @@ from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, write_json
 from adhesive_contact.visuals import PLOT_NAMES, write_plots
 
-from .summary import smallness_record, step_records
+from .summary import energy_record, smallness_record, step_records
 
 #: the version of summary.json's layout (docs/outputs.md): raised when a key
 #: changes meaning or goes; new keys do not change it
@@ -68,6 +68,7 @@ def summary(solution, source=None):
         "linear": dict(solution.linear),
         "resources": resources_record(solution),
         "iterations": [int(i) for i in solution.iterations],
+        "energy": energy_record(solution),
         "steps": step_records(solution),
     }
 

@@ -7,6 +7,8 @@ import numpy as np
 
 from adhesive_contact.postprocess import beta_mean, contact_state_counts, total_contact_force
 from adhesive_contact.postprocess import reaction_sides, reactions
+from adhesive_contact.postprocess import (debond_fronts, debonded_area, energies,
+                                          energy_per_area, energy_unavailable)
 from adhesive_contact.storage import json_number
 
 
@@ -24,6 +26,34 @@ def smallness_record(problem):
         return None
     return {key: (bool(value) if isinstance(value, (bool, np.bool_)) else json_number(value))
             for key, value in small.items()}
+
+
+def energy_record(solution):
+    """The top-level ``energy`` of ``summary.json``: ``{"available", "reason"}``
+    (reason null when available)."""
+    reason = energy_unavailable(solution.problem)
+    return {"available": reason is None, "reason": reason}
+
+
+def _energy_at(history, n):
+    """``steps[n].energy``: external_work, stored and dissipated (each with
+    its parts and ``total``), balance (docs/outputs.md)."""
+    stored = {key: json_number(v[n]) for key, v in history.stored.items()}
+    stored["total"] = json_number(history.stored_total[n])
+    dissipated = {key: json_number(v[n]) for key, v in history.dissipated.items()}
+    dissipated["total"] = json_number(history.dissipated_total[n])
+    return {"external_work": json_number(history.external_work[n]), "stored": stored,
+            "dissipated": dissipated, "balance": json_number(history.balance[n])}
+
+
+def _debonding_at(area, damage, per_area, per_damage, front, n):
+    """``steps[n].debonding``: the debonded area, the damage integral, the
+    glue's dissipation per unit of each, the front's points (2D)."""
+    return {"area": json_number(area[n]), "damage": json_number(damage[n]),
+            "energy_per_area": json_number(per_area[n]) if per_area is not None else None,
+            "energy_per_damage": (json_number(per_damage[n]) if per_damage is not None
+                                  else None),
+            "front": None if front is None else [_vector(p) for p in front[n]]}
 
 
 def _count(values, n):
@@ -59,6 +89,15 @@ def step_records(solution):
     boundary = solution.problem.boundary
     contact = (total_contact_force(solution) if boundary is not None and boundary.nodes.size
                else None)
+    history = energies(solution)
+    debonding = None
+    if boundary is not None and boundary.facets.size:
+        area, damage = debonded_area(solution)
+        glue = None if history is None else history.dissipated["debonding"]
+        debonding = (area, damage,
+                     None if glue is None else energy_per_area(glue, area),
+                     None if glue is None else energy_per_area(glue, damage),
+                     debond_fronts(solution) if d == 2 else None)
     records = []
     for n, t in enumerate(solution.t):
         has_beta = solution.beta.shape[1] > 0
@@ -79,5 +118,7 @@ def step_records(solution):
             "residual": json_number(solution.residual[n]),
             "reactions": {side: _vector(held[n, i]) for i, side in enumerate(sides)},
             "contact_force": None if contact is None else _vector(contact[n]),
+            "energy": None if history is None else _energy_at(history, n),
+            "debonding": None if debonding is None else _debonding_at(*debonding, n),
         })
     return records

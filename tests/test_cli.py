@@ -25,9 +25,9 @@ SCENE = to_toml(BLOCK)
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "separated", "on_wall", "stick", "slip", "max_penetration",
-             "iterations", "residual", "reactions", "contact_force"}
+             "iterations", "residual", "reactions", "contact_force", "energy", "debonding"}
 SUMMARY_KEYS = {"schema", "scene", "source", "mesh", "run", "smallness", "warnings", "timings",
-                "linear", "resources", "iterations", "steps"}
+                "linear", "resources", "iterations", "energy", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
                   "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",
                   "trace_lower_estimate",
@@ -138,11 +138,15 @@ def test_summary_has_one_record_per_level(solved):
         assert isinstance(step["tangential_force"], float)
         assert step["iterations"] == summary["iterations"][n]
         assert step["beta_mean"] == pytest.approx(1.0)   # no bonding law: β = β_0 = 1
+        assert step["energy"] is None          # a prony kernel has no free energy
+        assert step["debonding"]["area"] == 0.0 and step["debonding"]["front"] == []
         assert step["beta_min"] == pytest.approx(1.0)
         assert step["stick"] is None and step["slip"] is None    # no friction law
         assert isinstance(step["on_wall"], int)
         assert isinstance(step["separated"], int)
         assert step["separated"] + step["on_wall"] <= 9
+    assert summary["energy"]["available"] is False
+    assert "grows with time" in summary["energy"]["reason"]
     assert steps[0]["on_wall"] == 0
     assert steps[0]["normal_force"] == pytest.approx(0.0)
     assert steps[0]["max_penetration"] == pytest.approx(-0.002)   # min gap, at x = 1
@@ -559,8 +563,10 @@ def test_glued_contact_xdmf_has_beta_per_time_step(glued):
 def test_glued_plots_are_written(glued):
     result, out, _, _ = glued
     assert "Γ_C at t = 1: β mean" in result.stdout and "slip" in result.stdout
-    assert set(p.name for p in out.iterdir()) == FILES | {"load_displacement.png"}
-    for name in ("contact_traction.png", "beta.png", "load_displacement.png"):
+    # a prony kernel has no energy balance (no energy.png); the glue breaks
+    assert set(p.name for p in out.iterdir()) == FILES | {"load_displacement.png",
+                                                          "debonding.png"}
+    for name in ("contact_traction.png", "beta.png", "load_displacement.png", "debonding.png"):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
 
 

@@ -17,7 +17,7 @@ from adhesive_contact import (
     scene_from_dict,
     solve,
 )
-from adhesive_contact.postprocess import beta_mean
+from adhesive_contact.postprocess import beta_mean, energies, reactions
 from adhesive_contact.studies import StudyError, Sweep, parse_assignment
 from adhesive_contact.studies.sweep import split_values, variants, with_value
 
@@ -149,6 +149,13 @@ def test_grid_sweep_rows_match_direct_solves_and_failures_are_rows(grid_sweep):
         assert int(row["separated_T"]) == (un[-1] < 0).sum()
         assert float(row["max_un_minus_g"]) == pytest.approx(
             (un - problem.gap).max(), abs=1e-15)
+        # the held side's reaction: its peak (largest magnitude, signed) and at T
+        held = reactions(solution)[:, 0, :]
+        for c, axis in enumerate("xy"):
+            biggest = held[np.abs(held[:, c]).argmax(), c]
+            assert float(row[f"reaction_top_{axis}_peak"]) == pytest.approx(biggest, rel=1e-14)
+            assert float(row[f"reaction_top_{axis}_T"]) == pytest.approx(held[-1, c], rel=1e-14)
+        assert row["work_T"] == "" and row["debonded_area_T"] == "0.0"   # prony: no energy
         assert float(row["worker_peak_rss_mib"]) > 10
         assert float(row["seconds"]) > 0
     assert [r["outcome"] for r in rows] == ["ok", "ok", "failed", "ok"]
@@ -228,3 +235,28 @@ def test_sweep_from_python_with_progress(tmp_path, capsys):
     assert "did not converge" in result.records[0]["failure"]["message"]
     assert result.computed == [0, 1]
     assert np.isfinite(result.rows[1]["normal_force_T"])
+
+
+def test_sweep_reports_energies_and_debonded_area(tmp_path):
+    """The built-in scene swept over its number of steps: the energies and
+    the debonded area at T of each run are those of a direct solve."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "cli" / "default_scene.toml").read_text()
+    result = Sweep(text, [("time.steps", [20, 40])], folder=tmp_path / "out").run()
+    for row in result.rows:
+        problem = build_problem(scene_from_dict(with_value(
+            __import__("tomllib").loads(text), "time.steps", row["time.steps"])))
+        solution = solve(problem)
+        e = energies(solution)
+        assert row["work_T"] == pytest.approx(e.external_work[-1], rel=1e-12)
+        assert row["debonding_T"] == pytest.approx(e.dissipated["debonding"][-1], rel=1e-12)
+        assert row["numerical_T"] == pytest.approx(e.dissipated["numerical"][-1], rel=1e-12)
+        area = (solution.beta[-1] < 0.5) @ problem.boundary.measure
+        assert row["debonded_area_T"] == pytest.approx(area) and area > 0
+        assert row["glue_energy_per_area_T"] == pytest.approx(row["debonding_T"] / area)
+        lift = reactions(solution)[:, 1, 1]        # the right side, lifted in y
+        assert row["reaction_right_y_peak"] == pytest.approx(lift[np.abs(lift).argmax()])
+    header = (tmp_path / "out" / "runs.csv").read_text().splitlines()[0].split(",")
+    assert {"reaction_left_x_peak", "reaction_right_y_T", "work_T", "dissipated_T",
+            "balance_T", "damage_T"} <= set(header)

@@ -55,7 +55,8 @@ from adhesive_contact import visuals
 fig = visuals.figure_contact_traction(solution)
 assert fig.axes[2].get_xlabel() == "x along Γ_C (units of length)"
 names = visuals.write_plots(solution, sys.argv[1])   # a str folder
-assert names == ["deformed.png", "contact_traction.png", "beta.png", "load_displacement.png"]
+assert names == ["deformed.png", "contact_traction.png", "beta.png", "load_displacement.png",
+                 "energy.png", "debonding.png"]
 assert matplotlib.get_backend() == "svg", matplotlib.get_backend()
 assert "adhesive_contact_cli" not in sys.modules
 print("backend:", matplotlib.get_backend())

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.quantities import beta_mean
+from ..postprocess.scalars import scalar_quantities
 from ..postprocess.states import contact_state_counts
 from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
@@ -211,8 +212,10 @@ def run_variant(document, values):
     ``compliance_T``, ``stick_T``, ``slip_T`` (None without friction) and
     ``normal_force_T`` (the total normal force of Γ_C on the body, positive
     in compression); ``max_un_minus_g`` is max over all levels and contact
-    nodes of u_ν − g (None without a wall). A failed run has None for what
-    needs the solution.
+    nodes of u_ν − g (None without a wall); ``quantities`` the scalars of
+    :func:`~adhesive_contact.postprocess.scalar_quantities` (the peak and
+    final reaction of each held side, the energies and the debonded area at
+    T). A failed run has None for what needs the solution.
     """
     t0 = time.perf_counter()
     problem = build_problem(scene_from_dict(variant_document(document, values)))
@@ -237,7 +240,8 @@ def run_variant(document, values):
         "max_un_minus_g": solution.gap_violation().max(),
         **{f"{key}_T": states.get(key) for key in ("separated", "on_wall", "compliance",
                                                   "stick", "slip")},
-        "normal_force_T": solution.total_normal_force()[-1]})
+        "normal_force_T": solution.total_normal_force()[-1],
+        "quantities": scalar_quantities(solution)})
 
 
 def _setup(document, runs):
@@ -252,17 +256,30 @@ def _compute_run(state, key):
 # ---------------------------------------------------------------- rows
 
 
-def csv_columns(keys):
-    """The columns of runs.csv: run, the swept keys, then :data:`MEASURED`."""
-    return ["run", *keys, *MEASURED]
+def quantity_columns(records):
+    """The scalar quantities of the runs' records, in the order they first
+    appear (the held sides may differ between variants)."""
+    names = {}
+    for record in records:
+        names.update(dict.fromkeys(record.get("quantities") or {}))
+    return list(names)
 
 
-def run_row(record, keys):
+def csv_columns(keys, quantities=()):
+    """The columns of runs.csv: run, the swept keys, :data:`MEASURED`, then
+    the scalar ``quantities`` (:func:`quantity_columns`)."""
+    return ["run", *keys, *MEASURED, *quantities]
+
+
+def run_row(record, keys, quantities=()):
     """One runs.csv row (a dict by column) of a run record."""
     failure = record.get("failure") or {}
     row = {"run": record["run"], **{key: record["values"][key] for key in keys}}
     for column in MEASURED:
         row[column] = record.get(column)
+    given = record.get("quantities") or {}
+    for column in quantities:
+        row[column] = given.get(column)
     row.update(failed_step=failure.get("step"), failed_t=failure.get("t"))
     return row
 
@@ -277,9 +294,9 @@ def _cell(value):
     return value
 
 
-def write_runs_csv(path, rows, keys):
+def write_runs_csv(path, rows, keys, quantities=()):
     """``runs.csv``: a header of :func:`csv_columns`, one row per run; None empty."""
-    columns = csv_columns(keys)
+    columns = csv_columns(keys, quantities)
 
     def write(f):
         writer = csv.writer(f, lineterminator="\n")
@@ -415,8 +432,9 @@ class Sweep(Study):
             on_record=lambda key, record: progress("runs", len(done) + len(lost), total),
             label=lambda key: f"run {key}", on_lost=on_lost)
         records = [done[key] if key in done else lost[key] for key in self.keys()]
-        rows = [run_row(record, self.keys_set) for record in records]
-        write_runs_csv(self.folder / "runs.csv", rows, self.keys_set)
+        quantities = quantity_columns(records)
+        rows = [run_row(record, self.keys_set, quantities) for record in records]
+        write_runs_csv(self.folder / "runs.csv", rows, self.keys_set, quantities)
         return SweepResult(records, rows, [key for key in computed if key not in lost],
                            ["runs.csv"], sorted(lost))
 

@@ -3,7 +3,8 @@
 One module per figure of a run: :mod:`.deformed` (``deformed.png``),
 :mod:`.traction` (``contact_traction.png``), :mod:`.beta` (``beta.png``),
 :mod:`.contact_map` (``contact_map.png``, 3D), :mod:`.load`
-(``load_displacement.png``), and :func:`write_plots` (:mod:`.solution`)
+(``load_displacement.png``), :mod:`.energy` (``energy.png``),
+:mod:`.debonding` (``debonding.png``), and :func:`write_plots` (:mod:`.solution`)
 drawing those a solution has into a folder; :mod:`.studies` draws the
 figures of a convergence study and of a sweep; :mod:`.common` holds what
 they share (:class:`Units`, titles, :func:`save_figure`).
@@ -24,7 +25,9 @@ For example::
 from .beta import beta_space_time, figure_beta, plot_beta
 from .common import DPI, Units, plot_title, save_figure
 from .contact_map import figure_contact_map, plot_contact_map
+from .debonding import figure_debonding, plot_debonding
 from .deformed import figure_deformed, magnification, plot_deformed
+from .energy import figure_energy, plot_energy
 from .load import figure_load_displacement, load_curves, plot_load_displacement
 from .solution import PLOT_NAMES, write_plots
 from .studies import (
@@ -43,6 +46,7 @@ __all__ = ["DPI", "Units", "plot_title", "save_figure", "figure_deformed", "plot
            "magnification", "figure_contact_traction", "plot_contact_traction",
            "figure_beta", "plot_beta", "beta_space_time", "figure_contact_map",
            "plot_contact_map", "figure_load_displacement", "plot_load_displacement",
-           "load_curves", "PLOT_NAMES", "write_plots", "figure_error_vs_size",
+           "load_curves", "figure_energy", "plot_energy", "figure_debonding",
+           "plot_debonding", "PLOT_NAMES", "write_plots", "figure_error_vs_size",
            "plot_error_vs_size", "figure_work_precision", "plot_work_precision",
            "write_convergence_plots", "figure_by_key", "plot_by_key", "write_sweep_plots"]

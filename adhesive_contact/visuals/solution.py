@@ -6,12 +6,16 @@ import matplotlib.pyplot as plt
 
 from .beta import plot_beta
 from .contact_map import plot_contact_map
+from ..postprocess import energies
+from .debonding import plot_debonding
 from .deformed import plot_deformed
+from .energy import plot_energy
 from .load import load_curves, plot_load_displacement
 from .traction import plot_contact_traction
 
 #: the figures :func:`write_plots` may draw, without the ``.png``
-PLOT_NAMES = ("deformed", "contact_traction", "beta", "contact_map", "load_displacement")
+PLOT_NAMES = ("deformed", "contact_traction", "beta", "contact_map", "load_displacement",
+              "energy", "debonding")
 
 
 def write_plots(solution, folder, failures=None):
@@ -21,7 +25,8 @@ def write_plots(solution, folder, failures=None):
     ``deformed.png`` always; with a contact boundary ``contact_traction.png``
     (when it has contact nodes), ``beta.png`` and in 3D ``contact_map.png``
     (colour maps over Γ_C); ``load_displacement.png`` for scenes that move
-    or load a side. A scene without contact facets skips the contact
+    or load a side; ``energy.png`` where the run has an energy balance, and
+    ``debonding.png`` with contact facets and a bonding law. A scene without contact facets skips the contact
     figures (not an error). A figure that cannot be drawn is left out and,
     when ``failures`` is a list, named there with the reason: the plots must
     never cost the run's data.
@@ -52,6 +57,13 @@ def write_plots(solution, folder, failures=None):
     if curves:
         plots.append(("load_displacement.png",
                       lambda solution, path: plot_load_displacement(solution, path, curves)))
+    history = energies(solution)
+    if history is not None:
+        plots.append(("energy.png", lambda solution, path: plot_energy(solution, path, history)))
+    if (boundary is not None and boundary.facets.size
+            and solution.problem.bonding is not None):
+        plots.append(("debonding.png",
+                      lambda solution, path: plot_debonding(solution, path, history)))
     names = []
     for name, plot in plots:
         before = set(plt.get_fignums())
