@@ -5,7 +5,8 @@ this module only formats them.
 
 import numpy as np
 
-from adhesive_contact.postprocess import beta_mean, contact_state_counts, total_contact_force
+from adhesive_contact.postprocess import beta_mean, contact_state_counts, penetration
+from adhesive_contact.postprocess import total_contact_force
 from adhesive_contact.postprocess import reaction_sides, reactions
 from adhesive_contact.storage import json_number
 
@@ -42,7 +43,9 @@ def step_records(solution):
     without contact facets; separated, on_wall, stick and slip count contact
     nodes (:func:`~adhesive_contact.postprocess.contact_state_counts`; stick
     and slip are None without friction);
-    max_penetration is max_a (u_ν − g), None without a wall; ``reactions``
+    max_penetration is the deepest penetration of a contact node
+    (:func:`~adhesive_contact.postprocess.penetration`: into the foundation
+    itself with ``[contact.foundation]``, else max_a (u_ν − g)), None without a wall; ``reactions``
     is {side: [F_x, F_y(, F_z)]}, the force each held side's support exerts
     on the body (:mod:`adhesive_contact.postprocess.reactions`), and ``contact_force``
     the total force of Γ_C on the body in global components (None without
@@ -52,7 +55,7 @@ def step_records(solution):
     normal = solution.total_normal_force()
     tangential = solution.total_tangential_force()
     means = beta_mean(solution)
-    violation = solution.gap_violation()
+    violation = penetration(solution)
     states = contact_state_counts(solution)
     sides = reaction_sides(solution.problem)
     held = reactions(solution)

@@ -4,7 +4,8 @@ forces, β means (:mod:`.quantities`), the contact state of every node
 Their figures are :mod:`adhesive_contact.visuals`."""
 
 from .quantities import (FRAMES, beta_mean, cell_von_mises, contact_fields,
-                         contact_nodal_forces, contact_traction, normal_traction, stress_3x3,
+                         contact_nodal_forces, contact_traction, normal_traction, penetration,
+                         stress_3x3,
                          tangential_traction, to_global, total_contact_force, von_mises)
 from .reactions import (applied_traction, prescribed_history, reaction_sides, reactions,
                         side_mean_displacement, side_reactions)
@@ -12,7 +13,7 @@ from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STICK, WALL, cont
                      contact_state_codes, contact_state_counts, contact_states, state_masks)
 
 __all__ = ["FRAMES", "beta_mean", "cell_von_mises", "contact_fields", "contact_nodal_forces",
-           "contact_traction", "normal_traction", "stress_3x3", "tangential_traction",
+           "contact_traction", "normal_traction", "penetration", "stress_3x3", "tangential_traction",
            "to_global", "total_contact_force", "von_mises", "applied_traction",
            "prescribed_history", "reaction_sides", "reactions", "side_mean_displacement",
            "side_reactions", "COMPLIANCE", "SEPARATED", "SLIP", "STATE_NAMES", "STICK", "WALL",

@@ -17,6 +17,7 @@ nodal force over the lumped nodal weight w_a = ∫_{Γ_C} φ_a
 
 import numpy as np
 
+from ..fem.foundation import signed_distance
 from .states import contact_state_code
 
 FRAMES = ("nodal", "global")
@@ -179,3 +180,27 @@ def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):
             "u_normal": frame_displacement[:, 0],
             "slip": np.linalg.norm(frame_displacement[:, 1:], axis=-1),
             "state": contact_state_code(problem, frame_displacement, on_wall, stuck)}
+
+
+def penetration(solution):
+    """max_a of the penetration of the contact nodes per level (M+1,): with
+    ``[contact.foundation]`` the depth of the displaced node inside the
+    foundation itself, −d_F(x_a + u_a) (d_F the signed distance from its
+    surface, :func:`~adhesive_contact.fem.foundation.signed_distance`); with
+    a gap expression u_ν − g. Over the nodes whose u_ν is not held
+    (−inf without a wall or such nodes); ≤ 0 where every node is outside.
+
+    On a plane u_ν − g = −d_F(x_a + u_a) exactly; on a sphere or cylinder
+    the wall u_ν ≤ g is its linearisation at the closest point: a node on
+    the wall sits on the tangent there, √(r² + |u_τ|²) − r ≈ |u_τ|²/(2r)
+    outside the (convex) foundation."""
+    problem = solution.problem
+    foundation = problem.scene.contact.foundation
+    if foundation is None or problem.gap is None or problem.gap.shape[1] == 0:
+        return solution.gap_violation()
+    boundary = problem.boundary
+    x = problem.mesh.p[:, boundary.nodes]                               # (d, nc)
+    # level by level: u may be read from disk (StreamingRecorder)
+    depth = np.array([-signed_distance(foundation, x + solution.u[n][boundary.nodes].T)
+                      for n in range(solution.t.size)]).reshape(solution.t.size, -1)
+    return np.where(boundary.held[:, 0], -np.inf, depth).max(axis=1)
