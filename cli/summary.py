@@ -5,7 +5,8 @@ this module only formats them.
 
 import numpy as np
 
-from adhesive_contact.postprocess import beta_mean, contact_state_counts, penetration
+from adhesive_contact.postprocess import beta_mean, contact_measure, contact_state_counts
+from adhesive_contact.postprocess import penetration
 from adhesive_contact.postprocess import total_contact_force
 from adhesive_contact.postprocess import reaction_sides, reactions
 from adhesive_contact.storage import json_number
@@ -35,14 +36,17 @@ def step_records(solution):
     """The per-level entries of ``summary.json``'s ``steps`` list.
 
     Each is ``{"t", "probes", "normal_force", "tangential_force", "beta_mean",
-    "beta_min", "separated", "on_wall", "stick", "slip",
+    "beta_min", "separated", "on_wall", "stick", "slip", "contact_measure",
     "max_penetration", "iterations", "residual"}``: normal_force is the total
     force of Γ_C on the body, positive in compression; tangential_force its
     tangential part in the nodal frames, a number in 2D and a list of d − 1
     in 3D; beta_mean (weighted by the facet measures) and beta_min are None
     without contact facets; separated, on_wall, stick and slip count contact
     nodes (:func:`~adhesive_contact.postprocess.contact_state_counts`; stick
-    and slip are None without friction);
+    and slip are None without friction); contact_measure the width (2D) or
+    area (3D) of Γ_C in contact
+    (:func:`~adhesive_contact.postprocess.contact_measure`, None without
+    contact nodes);
     max_penetration is the deepest penetration of a contact node
     (:func:`~adhesive_contact.postprocess.penetration`: into the foundation
     itself with ``[contact.foundation]``, else max_a (u_ν − g)), None without a wall; ``reactions``
@@ -60,8 +64,9 @@ def step_records(solution):
     sides = reaction_sides(solution.problem)
     held = reactions(solution)
     boundary = solution.problem.boundary
-    contact = (total_contact_force(solution) if boundary is not None and boundary.nodes.size
-               else None)
+    has_nodes = boundary is not None and boundary.nodes.size > 0
+    contact = total_contact_force(solution) if has_nodes else None
+    in_contact = contact_measure(solution) if has_nodes else None
     records = []
     for n, t in enumerate(solution.t):
         has_beta = solution.beta.shape[1] > 0
@@ -77,6 +82,7 @@ def step_records(solution):
             "on_wall": _count(states["on_wall"], n),
             "stick": _count(states.get("stick"), n),
             "slip": _count(states.get("slip"), n),
+            "contact_measure": None if in_contact is None else json_number(in_contact[n]),
             "max_penetration": json_number(violation[n]),
             "iterations": int(solution.iterations[n]),
             "residual": json_number(solution.residual[n]),

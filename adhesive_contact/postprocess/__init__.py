@@ -9,13 +9,16 @@ from .quantities import (FRAMES, beta_mean, cell_von_mises, contact_fields,
                          tangential_traction, to_global, total_contact_force, von_mises)
 from .reactions import (applied_traction, prescribed_history, reaction_sides, reactions,
                         side_mean_displacement, side_reactions)
-from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STICK, WALL, contact_state_code,
-                     contact_state_codes, contact_state_counts, contact_states, state_masks)
+from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STATE_TOLERANCE, STICK, WALL,
+                     contact_measure, contact_state_code, contact_state_codes,
+                     contact_state_counts, contact_states, state_masks, state_tolerance)
 
 __all__ = ["FRAMES", "beta_mean", "cell_von_mises", "contact_fields", "contact_nodal_forces",
-           "contact_traction", "normal_traction", "penetration", "stress_3x3", "tangential_traction",
+           "contact_traction", "normal_traction", "penetration", "stress_3x3",
+           "tangential_traction",
            "to_global", "total_contact_force", "von_mises", "applied_traction",
            "prescribed_history", "reaction_sides", "reactions", "side_mean_displacement",
-           "side_reactions", "COMPLIANCE", "SEPARATED", "SLIP", "STATE_NAMES", "STICK", "WALL",
-           "contact_state_code", "contact_state_codes", "contact_state_counts", "contact_states",
-           "state_masks"]
+           "side_reactions", "COMPLIANCE", "SEPARATED", "SLIP", "STATE_NAMES", "STATE_TOLERANCE",
+           "STICK", "WALL",
+           "contact_measure", "contact_state_code", "contact_state_codes", "contact_state_counts",
+           "contact_states", "state_masks", "state_tolerance"]

@@ -141,7 +141,8 @@ def contact_traction(solution, frame="nodal"):
 
 
 def normal_traction(solution):
-    """Normal traction −σ_ν at the contact nodes, positive in compression, (N+1, nc)."""
+    """Normal traction −σ_ν at the contact nodes, positive in compression, (N+1, nc):
+    the contact pressure, −F_{a,ν} / w_a."""
     return -contact_traction(solution)[:, :, 0]
 
 
@@ -165,12 +166,12 @@ def beta_mean(solution):
     return solution.beta @ boundary.measure / boundary.measure.sum()
 
 
-def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):
+def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck, gap=None):
     """The per-node contact quantities of one level, for ParaView:
     ``traction`` (nc, d) global components, ``normal_traction`` (nc,)
     positive in compression, ``tangential_traction`` (nc, d−1) in the nodal
     tangent frames, ``u_normal`` (nc,), ``slip`` |u_τ| (nc,), ``state`` (nc,)
-    (:func:`contact_state_code`)."""
+    (:func:`contact_state_code`; ``gap`` (nc,) the level's g, if any)."""
     weights = problem.boundary.node_weights[:, None]
     nodal = np.asarray(contact_force) / weights
     frame_displacement = np.asarray(frame_displacement)
@@ -179,7 +180,7 @@ def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):
             "tangential_traction": nodal[:, 1:],
             "u_normal": frame_displacement[:, 0],
             "slip": np.linalg.norm(frame_displacement[:, 1:], axis=-1),
-            "state": contact_state_code(problem, frame_displacement, on_wall, stuck)}
+            "state": contact_state_code(problem, frame_displacement, on_wall, stuck, gap)}
 
 
 def penetration(solution):
