@@ -5,10 +5,20 @@ this module only formats them.
 
 import numpy as np
 
-from adhesive_contact.postprocess import beta_mean, contact_state_counts, total_contact_force
-from adhesive_contact.postprocess import reaction_sides, reactions
-from adhesive_contact.postprocess import (debond_fronts, debonded_area, energies,
-                                          energy_per_area, energy_unavailable)
+from adhesive_contact.postprocess import (
+    beta_mean,
+    contact_measure,
+    contact_state_counts,
+    debond_fronts,
+    debonded_area,
+    energies,
+    energy_per_area,
+    energy_unavailable,
+    penetration,
+    reaction_sides,
+    reactions,
+    total_contact_force,
+)
 from adhesive_contact.storage import json_number
 
 
@@ -64,15 +74,20 @@ def step_records(solution):
     """The per-level entries of ``summary.json``'s ``steps`` list.
 
     Each is ``{"t", "probes", "normal_force", "tangential_force", "beta_mean",
-    "beta_min", "separated", "on_wall", "stick", "slip",
+    "beta_min", "separated", "on_wall", "stick", "slip", "contact_measure",
     "max_penetration", "iterations", "residual"}``: normal_force is the total
     force of Γ_C on the body, positive in compression; tangential_force its
     tangential part in the nodal frames, a number in 2D and a list of d − 1
     in 3D; beta_mean (weighted by the facet measures) and beta_min are None
     without contact facets; separated, on_wall, stick and slip count contact
     nodes (:func:`~adhesive_contact.postprocess.contact_state_counts`; stick
-    and slip are None without friction);
-    max_penetration is max_a (u_ν − g), None without a wall; ``reactions``
+    and slip are None without friction); contact_measure the width (2D) or
+    area (3D) of Γ_C in contact
+    (:func:`~adhesive_contact.postprocess.contact_measure`, None without
+    contact nodes);
+    max_penetration is the deepest penetration of a contact node
+    (:func:`~adhesive_contact.postprocess.penetration`: into the foundation
+    itself with ``[contact.foundation]``, else max_a (u_ν − g)), None without a wall; ``reactions``
     is {side: [F_x, F_y(, F_z)]}, the force each held side's support exerts
     on the body (:mod:`adhesive_contact.postprocess.reactions`), and ``contact_force``
     the total force of Γ_C on the body in global components (None without
@@ -82,13 +97,14 @@ def step_records(solution):
     normal = solution.total_normal_force()
     tangential = solution.total_tangential_force()
     means = beta_mean(solution)
-    violation = solution.gap_violation()
+    violation = penetration(solution)
     states = contact_state_counts(solution)
     sides = reaction_sides(solution.problem)
     held = reactions(solution)
     boundary = solution.problem.boundary
-    contact = (total_contact_force(solution) if boundary is not None and boundary.nodes.size
-               else None)
+    has_nodes = boundary is not None and boundary.nodes.size > 0
+    contact = total_contact_force(solution) if has_nodes else None
+    in_contact = contact_measure(solution) if has_nodes else None
     history = energies(solution)
     debonding = None
     if boundary is not None and boundary.facets.size:
@@ -113,6 +129,7 @@ def step_records(solution):
             "on_wall": _count(states["on_wall"], n),
             "stick": _count(states.get("stick"), n),
             "slip": _count(states.get("slip"), n),
+            "contact_measure": None if in_contact is None else json_number(in_contact[n]),
             "max_penetration": json_number(violation[n]),
             "iterations": int(solution.iterations[n]),
             "residual": json_number(solution.residual[n]),

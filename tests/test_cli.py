@@ -24,7 +24,7 @@ SCENE = to_toml(BLOCK)
 
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
-             "separated", "on_wall", "stick", "slip", "max_penetration",
+             "separated", "on_wall", "stick", "slip", "contact_measure", "max_penetration",
              "iterations", "residual", "reactions", "contact_force", "energy", "debonding"}
 SUMMARY_KEYS = {"schema", "scene", "source", "mesh", "run", "smallness", "warnings", "timings",
                 "linear", "resources", "iterations", "energy", "steps"}
@@ -79,7 +79,8 @@ def test_npz_has_the_firm_keys_and_shapes(solved):
     with np.load(out / "solution.npz") as data:
         # the firm keys, and the rest of the Solution (for load_solution)
         assert set(data.files) == {"points", "cells", "contact_facets", "t", "u", "beta",
-                                   "reactions", "reaction_sides"} | {
+                                   "reactions", "reaction_sides", "contact_nodes",
+                                   "contact_points", "contact_pressure"} | {
             "contact_force", "frame_displacement", "on_wall", "stuck", "probes", "iterations",
             "residual", "held_reaction", "stress_last", "stress_zz_last"}
         assert data["stress_last"].shape == (NCELLS, 2, 2)
@@ -100,6 +101,22 @@ def test_npz_has_the_firm_keys_and_shapes(solved):
         top = data["points"][:, 1] == 1.0
         assert np.all(data["u"][:, top] == 0.0)
         assert np.abs(data["u"][-1]).max() > 0
+        # the contact nodes: Γ_C's vertices in increasing index, their points,
+        # and the pressure −F_ν / w_a with w_a half the lengths of the facets
+        # around a, which sums to the summary's normal force
+        nodes = data["contact_nodes"]
+        np.testing.assert_array_equal(nodes, np.unique(data["contact_facets"]))
+        np.testing.assert_array_equal(data["contact_points"], data["points"][nodes])
+        facets = data["contact_facets"]
+        length = np.linalg.norm(np.diff(data["points"][facets], axis=1)[:, 0], axis=1)
+        w = np.zeros(len(data["points"]))
+        np.add.at(w, facets.ravel(), np.repeat(length / 2, 2))
+        pressure = data["contact_pressure"]
+        np.testing.assert_allclose(pressure, -data["contact_force"][:, :, 0] / w[nodes],
+                                   rtol=1e-12)
+        summary = json.loads((out / "summary.json").read_text())
+        np.testing.assert_allclose(pressure @ w[nodes],
+                                   [s["normal_force"] for s in summary["steps"]], rtol=1e-12)
 
 
 def test_the_history_is_stored_uncompressed_and_the_rest_compressed(solved):
@@ -145,6 +162,8 @@ def test_summary_has_one_record_per_level(solved):
         assert isinstance(step["on_wall"], int)
         assert isinstance(step["separated"], int)
         assert step["separated"] + step["on_wall"] <= 9
+        if step["separated"] == 0:     # the whole bottom, 2 long, is in contact
+            assert step["contact_measure"] == pytest.approx(2.0, rel=1e-14)
     assert summary["energy"]["available"] is False
     assert "grows with time" in summary["energy"]["reason"]
     assert steps[0]["on_wall"] == 0

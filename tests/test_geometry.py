@@ -26,6 +26,7 @@ from adhesive_contact import (
 from adhesive_contact.fem.contact_boundary import facet_normals
 from adhesive_contact.fem.meshes import build_mesh, read_mesh_file
 from adhesive_contact.fem.meshes.builtin import structured_mesh
+from adhesive_contact.postprocess import penetration, total_contact_force
 from adhesive_contact.scene import MeshSpec
 from adhesive_contact.verification.errors import prolongation
 
@@ -245,27 +246,30 @@ def test_plane_foundation_on_a_flat_side_is_a_constant_gap():
     np.testing.assert_allclose(b.u, a.u, rtol=0, atol=1e-14)
 
 
-def test_foundation_gap_along_the_nodal_normal():
-    """Half-disc foot over a slanted plane and over a disc: the gap at each
-    node is the ray length along ν_a, checked against closed forms."""
+def test_foundation_normal_and_gap_at_the_closest_point():
+    """Half-disc foot over a slanted plane and over a disc: every contact
+    node's frame normal is the foundation's at its closest point and the
+    gap is the distance to it (node to surface), against closed forms."""
     base = {"contact.normal": law("compliance", c=1e3)}
     n = np.array([0.2, 1.0]) / np.hypot(0.2, 1.0)
     p = build_problem(scene_from_dict(file_scene(HALF_DISC, {**base, "contact.foundation": {
         "point": [0.0, -0.1], "normal": list(n)}})))
     x, nu = p.mesh.p[:, p.boundary.nodes], p.boundary.frame[:, :, 0].T
+    np.testing.assert_allclose(nu, np.broadcast_to(-n[:, None], nu.shape), rtol=0, atol=1e-15)
     depth = (x - np.array([[0.0], [-0.1]])).T @ n
-    cos = -(nu.T @ n)
-    facing = cos > 1e-12
-    np.testing.assert_allclose(p.gap[0][facing], depth[facing] / cos[facing], rtol=1e-13)
-    assert np.isinf(p.gap[0][~facing]).all() and (~facing).any()
-    # a disc of radius 0.5 around (0, -0.6): the hit point lies on its circle
+    np.testing.assert_allclose(p.gap[0], depth, rtol=1e-14)
+    assert np.isfinite(p.gap).all()
+    # a disc of radius 0.5 around (0, -0.6): ν along the centre, g = |x − c| − r,
+    # and x + g ν the closest point of the circle
     q = build_problem(scene_from_dict(file_scene(HALF_DISC, {**base, "contact.foundation": {
         "shape": "sphere", "point": [0.0, -0.6], "radius": 0.5}})))
-    g = q.gap[0]
-    hit = np.isfinite(g)
-    y = x[:, hit] + g[hit] * nu[:, hit]
-    np.testing.assert_allclose(np.hypot(y[0], y[1] + 0.6), 0.5, rtol=1e-12)
-    assert g[hit].min() == pytest.approx(0.1, abs=2e-3) and hit.sum() < hit.size
+    nu, g = q.boundary.frame[:, :, 0].T, q.gap[0]
+    w = x - np.array([[0.0], [-0.6]])
+    np.testing.assert_allclose(nu, -w / np.linalg.norm(w, axis=0), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(g, np.linalg.norm(w, axis=0) - 0.5, rtol=1e-14)
+    y = x + g * nu
+    np.testing.assert_allclose(np.hypot(y[0], y[1] + 0.6), 0.5, rtol=1e-14)
+    assert g.min() == pytest.approx(0.1, abs=2e-3)
 
 
 def test_cylinder_foundation_in_3d():
@@ -274,9 +278,58 @@ def test_cylinder_foundation_in_3d():
             "shape": "cylinder", "point": [0.0, -2.0, 0.0], "axis": [0.0, 0.0, 1.0],
             "radius": 1.9}}, dim=3)))
     x, nu, g = p.mesh.p[:, p.boundary.nodes], p.boundary.frame[:, :, 0].T, p.gap[0]
-    hit = np.isfinite(g)
-    y = x[:, hit] + g[hit] * nu[:, hit]
+    w = x - np.array([[0.0], [-2.0], [0.0]])
+    w[2] = 0.0
+    np.testing.assert_allclose(g, np.linalg.norm(w, axis=0) - 1.9, rtol=1e-13)
+    assert np.abs(nu[2]).max() == 0.0   # across the axis
+    y = x + g * nu
     np.testing.assert_allclose(np.hypot(y[0], y[1] + 2.0), 1.9, rtol=1e-12)
+
+
+def _pressed_half_disc(foundation, approach=0.01):
+    """The half-disc foot, its top pushed down by ``approach``, frictionless
+    Signorini contact with a foundation (two steps)."""
+    return run(file_scene(HALF_DISC, {
+        "boundary.dirichlet": [], "boundary.displacement": {"top": ["0", f"-{approach}*t"]},
+        "contact.normal": law("none"), "contact.foundation": foundation,
+        "time.steps": 2}))
+
+
+def test_a_curved_body_stays_on_a_plane_foundation():
+    """Node to surface: the wall bounds the displacement along the plane's
+    normal, so no node of the half-disc crosses the plane y = 0 and the
+    nodes on the wall lie on it (to round-off). Along the body's own normal
+    the sideways displacement entered the bound and the wall nodes sank
+    below the plane by up to 5 % of the approach; the penetration is
+    reported against the plane itself."""
+    problem, solution = _pressed_half_disc({"point": [0.0, 0.0], "normal": [0.0, 1.0]})
+    assert solution.success and solution.on_wall[-1].sum() >= 3
+    y = problem.mesh.p[1, problem.boundary.nodes] + solution.u[:, problem.boundary.nodes, 1]
+    assert y.min() > -1e-14
+    np.testing.assert_allclose(y[solution.on_wall], 0.0, atol=1e-14)
+    # the wall's force is along the plane's normal: the total contact force is vertical
+    total = total_contact_force(solution)[-1]
+    assert total[1] > 0 and abs(total[0]) < 1e-12 * total[1]
+    np.testing.assert_allclose(penetration(solution), -y.min(axis=1), rtol=0, atol=1e-15)
+
+
+def test_penetration_is_measured_against_a_curved_foundation():
+    """On a disc the wall is the linearisation of d_F(x + u) ≥ 0 at the
+    closest point: a node on the wall sits on the tangent at its closest
+    point, u_τ along it, at the distance √(r² + u_τ²) − r outside the
+    (convex) disc; the reported penetration is r − |x + u − c|."""
+    problem, solution = _pressed_half_disc({"shape": "sphere", "point": [0.0, -2.0],
+                                            "radius": 2.0}, approach=0.05)
+    assert solution.success and solution.on_wall[-1].sum() >= 3
+    nodes = problem.boundary.nodes
+    y = problem.mesh.p[:, nodes][None] + solution.u[:, nodes].transpose(0, 2, 1)
+    depth = 2.0 - np.hypot(y[:, 0], y[:, 1] + 2.0)
+    np.testing.assert_allclose(penetration(solution), depth.max(axis=1), rtol=0, atol=1e-15)
+    wall = solution.on_wall[-1]
+    slip = solution.frame_displacement[-1, wall, 1]
+    assert np.abs(slip).max() > 1e-4
+    np.testing.assert_allclose(depth[-1, wall], 2.0 - np.sqrt(4.0 + slip ** 2), rtol=1e-6,
+                               atol=1e-15)
 
 
 @pytest.mark.parametrize("changes, message", [

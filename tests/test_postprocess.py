@@ -17,11 +17,14 @@ from adhesive_contact import build_problem, scene_from_dict, solve
 from adhesive_contact.postprocess import (
     beta_mean,
     cell_von_mises,
+    contact_measure,
     contact_nodal_forces,
     contact_state_counts,
     contact_states,
     contact_traction,
     normal_traction,
+    state_masks,
+    state_tolerance,
     stress_3x3,
     tangential_traction,
     to_global,
@@ -161,6 +164,50 @@ def test_contact_states_partition_the_nodes(solution):
     for key, value in counts.items():
         np.testing.assert_array_equal(states[key].sum(axis=1), value)
     assert states["compliance"][-1].any() or states["on_wall"][-1].any()
+
+
+def test_states_use_a_tolerance_of_the_body_size(solution):
+    """u_ν = −1e-10 on a body of size 1.1 is touching; −1e-6 is separated;
+    a slip of 1e-10 is no slip. The tolerance is 1e-8 of the bounding
+    box's diagonal, √(1 + 0.25)."""
+    problem = solution.problem
+    nc = problem.boundary.nodes.size
+    assert state_tolerance(problem) == pytest.approx(1e-8 * math.sqrt(1.25), rel=1e-14)
+    z = np.zeros((nc, 2))
+    z[0] = [-1e-10, 1e-10]
+    z[1] = [-1e-6, 0.0]
+    z[2] = [0.0, 1e-6]
+    none = np.zeros(nc, dtype=bool)
+    masks = state_masks(problem, z, none, none)
+    assert not masks["separated"][0] and masks["compliance"][0] and not masks["slip"][0]
+    assert masks["separated"][1] and masks["slip"][2]
+
+
+def test_without_a_compliant_layer_touching_is_the_wall():
+    """law none with a wall: a node short of the wall (0 < u_ν < g) is
+    separated, whatever the sign of u_ν; one at u_ν = g (or in the wall
+    set) touches; no node is in compliance. The measure in contact is the
+    nodal weights of the touching nodes."""
+    problem = build_problem(scene_from_dict(scene_dict({
+        **{k: SCENE[k] for k in ("mesh", "time")}, "boundary.dirichlet": ["top"],
+        "contact": {"gap": "0.002", "normal": law("none")}})))
+    nc = problem.boundary.nodes.size
+    gap = problem.gap[0]
+    z = np.zeros((nc, 2))
+    z[:, 0] = 0.5 * gap                      # short of the wall
+    z[3, 0] = gap[3] - 1e-12                 # at the wall, not in the set
+    wall = np.zeros(nc, dtype=bool)
+    wall[4] = True                           # in the step method's set
+    z[4, 0] = gap[4]
+    masks = state_masks(problem, z, wall, wall, gap)
+    touching = np.zeros(nc, dtype=bool)
+    touching[[3, 4]] = True
+    np.testing.assert_array_equal(masks["separated"], ~touching)
+    assert not masks["compliance"].any()
+    # the same from a solution: the measure in contact
+    fake = SimpleNamespace(problem=problem, t=np.zeros(1), frame_displacement=z[None],
+                           on_wall=wall[None], stuck=wall[None])
+    assert contact_measure(fake)[0] == pytest.approx(problem.boundary.node_weights[[3, 4]].sum())
 
 
 # ---------------------------------------------------------------- storage

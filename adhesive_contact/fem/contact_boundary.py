@@ -7,7 +7,10 @@ contact node; its displacement is written in a local orthonormal frame,
 
 so that z_{a,0} = u_ν(x_a) and the wall u_ν ≤ g of K^h (docs/scheme.md) is a
 bound on one coordinate. ν_a is the length-weighted average of the outward
-normals of the facets of Γ_C around node a.
+normals of the facets of Γ_C around node a, or a given normal field
+(``normal_field``): with ``[contact.foundation]`` the foundation's normal
+at the node's closest point (:mod:`.foundation`), so that u_ν, the wall
+and the normal traction are measured along it.
 
 The contact unknowns are the frame components the boundary does not hold.
 A component held by a side (``boundary.dirichlet`` or
@@ -40,7 +43,8 @@ with β the P0 value of the facet f(q) holding q:
   points being the facet's vertices (weights |f|/d each) and u_ν, u_τ being
   the nodal components z_a; the terms then split node by node;
 - ``gauss``: a Gauss rule of the given exactness on each facet, with u the
-  P1 interpolant and ν, τ the facet's own normal and tangents.
+  P1 interpolant and ν, τ the facet's own normal and tangents (those of
+  the normal field at the point, when one is given).
 
 N and T act on all nc·d frame components, held ones included.
 """
@@ -211,10 +215,13 @@ class ContactBoundary:
                            minlength=self.facets.size) / self.measure
 
 
-def build_contact_boundary(mesh, contact_facets, held_dofs=(), quadrature="nodal", order=4):
+def build_contact_boundary(mesh, contact_facets, held_dofs=(), quadrature="nodal", order=4,
+                           normal_field=None):
     """Assemble :class:`ContactBoundary` for the given facets of ``mesh``;
     ``held_dofs`` (sorted) are the dofs the boundary holds (interleaved,
-    d·a + c)."""
+    d·a + c); ``normal_field``, a function of points (d, n) returning unit
+    normals (d, n), gives ν at the nodes (and at the points of a Gauss
+    rule) instead of the averaged facet normals."""
     d = mesh.dim()
     facets = np.asarray(contact_facets, dtype=np.int64)
     held_dofs = np.asarray(held_dofs, dtype=np.int64)
@@ -229,6 +236,8 @@ def build_contact_boundary(mesh, contact_facets, held_dofs=(), quadrature="nodal
     for i in range(d):
         np.add.at(acc.T, facet_nodes[i], (normal_f * measure).T)
     nodal_normal = acc[:, nodes] / np.linalg.norm(acc[:, nodes], axis=0)
+    if normal_field is not None:
+        nodal_normal = np.asarray(normal_field(mesh.p[:, nodes]), dtype=float)
     dofs = np.stack([d * nodes + c for c in range(d)], axis=1)  # interleaved dofs
     held_axes = np.isin(dofs, held_dofs)
     frame, held, frame_dofs = held_frames(tangent_frame(nodal_normal), held_axes, dofs)
@@ -244,7 +253,8 @@ def build_contact_boundary(mesh, contact_facets, held_dofs=(), quadrature="nodal
     # nodal: point (f, v) reads node facet_nodes[v, f] in its own frame;
     # gauss: the point reads the P1 interpolant in the facet's frame
     if quadrature == "gauss":
-        directions = np.repeat(tangent_frame(normal_f), nq_ref, axis=0)  # (nq, d, d)
+        directions = (np.repeat(tangent_frame(normal_f), nq_ref, axis=0)  # (nq, d, d)
+                      if normal_field is None else tangent_frame(normal_field(points)))
 
     nz = nodes.size * d
     traces = []

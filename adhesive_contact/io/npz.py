@@ -9,7 +9,11 @@ reads both.
 
 Keys (docs/outputs.md): ``points``, ``cells``, ``contact_facets``, ``t``,
 ``u``, ``beta``, ``reactions`` (N+1, n_sides, d): the force of each held
-side's support on the body, ``reaction_sides``: their names; and the rest
+side's support on the body, ``reaction_sides``: their names;
+``contact_nodes`` (nc,): the mesh indices of the contact nodes (the
+vertices of Γ_C in increasing index, the order of every per-node array),
+``contact_points`` (nc, d) their coordinates and ``contact_pressure``
+(N+1, nc) the normal traction −σ_ν there (positive in compression); and the rest
 of a :class:`~adhesive_contact.Solution` (:data:`SOLUTION_KEYS`), so that
 :func:`~adhesive_contact.io.load_solution` gives it back: ``contact_force``,
 ``frame_displacement``, ``on_wall``, ``stuck``, ``probes``, ``iterations``,
@@ -23,6 +27,7 @@ import zipfile
 
 import numpy as np
 
+from ..postprocess.quantities import normal_traction
 from ..postprocess.reactions import reaction_sides, reactions
 from .xdmf import contact_facets
 
@@ -66,6 +71,12 @@ def write_npz(solution, path):
         _write_array(archive, "beta", solution.beta)
         _write_array(archive, "reactions", reactions(solution))
         _write_array(archive, "reaction_sides", np.array(reaction_sides(problem), dtype=str))
+        nodes = (problem.boundary.nodes if problem.boundary is not None
+                 else np.zeros(0, dtype=np.int64))
+        _write_array(archive, "contact_nodes", nodes.astype(np.int64))
+        _write_array(archive, "contact_points", problem.mesh.p[:, nodes].T)
+        _write_array(archive, "contact_pressure",
+                     normal_traction(solution) if nodes.size else np.zeros((solution.t.size, 0)))
         for name in SOLUTION_KEYS:
             _write_array(archive, name, getattr(solution, name))
         held = solution.reaction if solution.reaction is not None else \

@@ -124,8 +124,9 @@ class XdmfSeries:
         """The contact fields of a level at the points of ``contact.xdmf``
         (every vertex of Γ_C is a contact node; the force is 0 along a
         held component, being in the side's reaction)."""
+        gap = None if self.problem.gap is None else self.problem.gap[level.n]
         fields = contact_fields(self.problem, level.contact_force, level.frame_displacement,
-                                level.on_wall, level.stuck)
+                                level.on_wall, level.stuck, gap)
         fields["on_wall"] = np.asarray(level.on_wall, dtype=float)
         out = {}
         for name, values in fields.items():
@@ -147,7 +148,7 @@ class _LevelOf:
     """Level n of a solution, as :meth:`XdmfSeries.write` reads it."""
 
     def __init__(self, solution, n):
-        self.t, self.u, self.beta = solution.t[n], solution.u[n], solution.beta[n]
+        self.n, self.t, self.u, self.beta = n, solution.t[n], solution.u[n], solution.beta[n]
         self.contact_force = solution.contact_force[n]
         self.frame_displacement = solution.frame_displacement[n]
         self.on_wall, self.stuck = solution.on_wall[n], solution.stuck[n]

@@ -8,19 +8,23 @@ Their figures are :mod:`adhesive_contact.visuals`."""
 from .energy import DISSIPATED, STORED, EnergyHistory, energies, energy_unavailable
 from .fracture import debond_front, debond_fronts, debonded_area, energy_per_area
 from .quantities import (FRAMES, beta_mean, cell_von_mises, contact_fields,
-                         contact_nodal_forces, contact_traction, normal_traction, stress_3x3,
-                         tangential_traction, to_global, total_contact_force, von_mises)
+                         contact_nodal_forces, contact_traction, normal_traction, penetration,
+                         stress_3x3, tangential_traction, to_global, total_contact_force,
+                         von_mises)
 from .reactions import (applied_traction, prescribed_history, reaction_sides, reactions,
                         side_mean_displacement, side_reactions)
 from .scalars import scalar_quantities
-from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STICK, WALL, contact_state_code,
-                     contact_state_codes, contact_state_counts, contact_states, state_masks)
+from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STATE_TOLERANCE, STICK, WALL,
+                     contact_measure, contact_state_code, contact_state_codes,
+                     contact_state_counts, contact_states, state_masks, state_tolerance)
 
 __all__ = ["DISSIPATED", "STORED", "EnergyHistory", "energies", "energy_unavailable",
-           "scalar_quantities", "debond_front", "debond_fronts", "debonded_area", "energy_per_area", "FRAMES", "beta_mean", "cell_von_mises", "contact_fields", "contact_nodal_forces",
-           "contact_traction", "normal_traction", "stress_3x3", "tangential_traction",
-           "to_global", "total_contact_force", "von_mises", "applied_traction",
-           "prescribed_history", "reaction_sides", "reactions", "side_mean_displacement",
-           "side_reactions", "COMPLIANCE", "SEPARATED", "SLIP", "STATE_NAMES", "STICK", "WALL",
-           "contact_state_code", "contact_state_codes", "contact_state_counts", "contact_states",
-           "state_masks"]
+           "debond_front", "debond_fronts", "debonded_area", "energy_per_area", "FRAMES",
+           "beta_mean", "cell_von_mises", "contact_fields", "contact_nodal_forces",
+           "contact_traction", "normal_traction", "penetration", "stress_3x3",
+           "tangential_traction", "to_global", "total_contact_force", "von_mises",
+           "applied_traction", "prescribed_history", "reaction_sides", "reactions",
+           "side_mean_displacement", "side_reactions", "scalar_quantities", "COMPLIANCE",
+           "SEPARATED", "SLIP", "STATE_NAMES", "STATE_TOLERANCE", "STICK", "WALL",
+           "contact_measure", "contact_state_code", "contact_state_codes", "contact_state_counts",
+           "contact_states", "state_masks", "state_tolerance"]

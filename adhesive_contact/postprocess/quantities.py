@@ -17,6 +17,7 @@ nodal force over the lumped nodal weight w_a = ∫_{Γ_C} φ_a
 
 import numpy as np
 
+from ..fem.foundation import signed_distance
 from .states import contact_state_code
 
 FRAMES = ("nodal", "global")
@@ -140,7 +141,8 @@ def contact_traction(solution, frame="nodal"):
 
 
 def normal_traction(solution):
-    """Normal traction −σ_ν at the contact nodes, positive in compression, (N+1, nc)."""
+    """Normal traction −σ_ν at the contact nodes, positive in compression, (N+1, nc):
+    the contact pressure, −F_{a,ν} / w_a."""
     return -contact_traction(solution)[:, :, 0]
 
 
@@ -164,12 +166,12 @@ def beta_mean(solution):
     return solution.beta @ boundary.measure / boundary.measure.sum()
 
 
-def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):
+def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck, gap=None):
     """The per-node contact quantities of one level, for ParaView:
     ``traction`` (nc, d) global components, ``normal_traction`` (nc,)
     positive in compression, ``tangential_traction`` (nc, d−1) in the nodal
     tangent frames, ``u_normal`` (nc,), ``slip`` |u_τ| (nc,), ``state`` (nc,)
-    (:func:`contact_state_code`)."""
+    (:func:`contact_state_code`; ``gap`` (nc,) the level's g, if any)."""
     weights = problem.boundary.node_weights[:, None]
     nodal = np.asarray(contact_force) / weights
     frame_displacement = np.asarray(frame_displacement)
@@ -178,4 +180,28 @@ def contact_fields(problem, contact_force, frame_displacement, on_wall, stuck):
             "tangential_traction": nodal[:, 1:],
             "u_normal": frame_displacement[:, 0],
             "slip": np.linalg.norm(frame_displacement[:, 1:], axis=-1),
-            "state": contact_state_code(problem, frame_displacement, on_wall, stuck)}
+            "state": contact_state_code(problem, frame_displacement, on_wall, stuck, gap)}
+
+
+def penetration(solution):
+    """max_a of the penetration of the contact nodes per level (M+1,): with
+    ``[contact.foundation]`` the depth of the displaced node inside the
+    foundation itself, −d_F(x_a + u_a) (d_F the signed distance from its
+    surface, :func:`~adhesive_contact.fem.foundation.signed_distance`); with
+    a gap expression u_ν − g. Over the nodes whose u_ν is not held
+    (−inf without a wall or such nodes); ≤ 0 where every node is outside.
+
+    On a plane u_ν − g = −d_F(x_a + u_a) exactly; on a sphere or cylinder
+    the wall u_ν ≤ g is its linearisation at the closest point: a node on
+    the wall sits on the tangent there, √(r² + |u_τ|²) − r ≈ |u_τ|²/(2r)
+    outside the (convex) foundation."""
+    problem = solution.problem
+    foundation = problem.scene.contact.foundation
+    if foundation is None or problem.gap is None or problem.gap.shape[1] == 0:
+        return solution.gap_violation()
+    boundary = problem.boundary
+    x = problem.mesh.p[:, boundary.nodes]                               # (d, nc)
+    # level by level: u may be read from disk (StreamingRecorder)
+    depth = np.array([-signed_distance(foundation, x + solution.u[n][boundary.nodes].T)
+                      for n in range(solution.t.size)]).reshape(solution.t.size, -1)
+    return np.where(boundary.held[:, 0], -np.inf, depth).max(axis=1)

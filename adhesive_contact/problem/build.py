@@ -36,7 +36,7 @@ from ..fem.contact_boundary import (
     tangent_frame,
 )
 from ..fem.dirichlet import prescribed_displacement
-from ..fem.foundation import foundation_gap
+from ..fem.foundation import foundation_gap, foundation_normal
 from ..fem.meshes import build_mesh, named_facets
 from ..laws import make_bonding, make_friction, make_normal_law
 from ..scene import SceneError
@@ -175,9 +175,14 @@ def contact(scene, mesh, assembly, held, laws, times):
     empty = np.zeros(0, dtype=np.int64)
     if not scene.has_contact_terms:
         return Contact(None, empty, empty, None)
-    # every vertex of Γ_C is a contact node; its held components are no unknowns
+    # every vertex of Γ_C is a contact node; its held components are no unknowns.
+    # On a foundation ν is the foundation's normal at the closest point
+    foundation = scene.contact.foundation
+    normal_field = (None if foundation is None else
+                    (lambda x: foundation_normal(foundation, x)[0]))
     boundary = build_contact_boundary(mesh, held.contact_facets, held.prescribed.fixed,
-                                      scene.contact.quadrature, scene.contact.order)
+                                      scene.contact.quadrature, scene.contact.order,
+                                      normal_field)
     assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
     # without friction only u_ν enters the contact terms (the traces of
     # the tangential components vanish on flat facets): solve for it alone
@@ -193,12 +198,17 @@ def contact(scene, mesh, assembly, held, laws, times):
 
 def gap_at_nodes(scene, mesh, boundary, times):
     """g(x_a, t_n) (N+1, nc) at the contact nodes: the scene's gap
-    expression, or the distance to the foundation along the nodal normal
-    ν_a (:mod:`~adhesive_contact.fem.foundation`; +∞ where the normal misses it)."""
+    expression, or the distance d_F(x_a) to the foundation
+    (:mod:`~adhesive_contact.fem.foundation`), measured along the frame
+    normal ν_a where held components turned ν_a off the foundation's
+    normal (+∞ where that misses it)."""
     x = mesh.p[:, boundary.nodes]
     if scene.contact.foundation is not None:
-        g, depth = foundation_gap(scene.contact.foundation, x, boundary.frame[:, :, 0].T)
+        nu = boundary.frame[:, :, 0].T
+        along, depth = foundation_gap(scene.contact.foundation, x, nu)
         check_outside_foundation(x, depth)
+        own = np.all(nu == foundation_normal(scene.contact.foundation, x)[0], axis=0)
+        g = np.where(own, np.maximum(depth, 0.0), along)
         return np.broadcast_to(g, (times.size, g.size)).copy()
     gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
     check_gap(gap, x, times)

@@ -4,7 +4,7 @@ normal displacement along Γ_C at a few time levels."""
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..postprocess import normal_traction, tangential_traction
+from ..postprocess import contact_states, normal_traction, tangential_traction
 from .common import (
     AXES,
     Units,
@@ -59,9 +59,9 @@ def figure_contact_traction(solution):
     shear = shear[:, :, 0] if problem.dim == 2 else np.linalg.norm(shear, axis=2)
     un = solution.normal_displacement[:, order]
     wall = solution.on_wall[:, order]
-    separated = un < 0
+    states = contact_states(solution)
     kinked = problem.friction is not None and problem.friction.has_kink
-    stuck = solution.stuck[:, order] & ~separated
+    stuck = states["stick"][:, order] if "stick" in states else np.zeros_like(wall)
     gap = None if problem.gap is None else problem.gap[:, order]
     style = "-" if problem.dim == 2 else "none"  # 3D: scattered nodes, no lines
 
