@@ -82,7 +82,7 @@ def test_held_sides_and_contact_terms_together_hold_the_body():
     assert held.held_by_contact == ()
 
 
-@pytest.mark.parametrize("linear", ["superlu", "amg"])
+@pytest.mark.parametrize("linear", ["superlu", "pardiso", "amg"])
 def test_a_block_pressed_onto_a_layer_by_a_load_is_the_closed_form(linear):
     """Uniform pressure q on top, rollers at x = 0, a layer of stiffness c
     below: σ_yy = −q, σ_xx = 0, so u_y = −q/c − q(1 − ν²) y/E and
