@@ -37,7 +37,12 @@ def check(scene):
                    f"(k = {parsed.k:.4g}: {'within' if parsed.k <= bound else 'beyond'}; "
                    f"integrator {parsed.contact.integrator})")
     small = problem.smallness
-    if small is not None:
+    if small is not None and small.get("held_by_contact"):
+        click.echo(f"  smallness: m_A = {small['m_A']:.4g}; the conditions do not apply: only "
+                   f"the contact terms hold the body against "
+                   f"{', '.join(small['held_by_contact'])}; step energy "
+                   f"{'convex' if small['step_energy_convex'] else 'may be nonconvex'}")
+    elif small is not None:
         click.echo(f"  smallness: m_A = {small['m_A']:.4g}; error estimate needs > "
                    f"{small['rhs']:.4g} ({'holds' if small['holds'] else 'does not hold'}); "
                    f"step energy {'convex' if small['step_energy_convex'] else 'may be nonconvex'}"

@@ -29,13 +29,20 @@ def _vector(values):
 def smallness_record(problem):
     """``problem.smallness`` as plain JSON (None without contact terms).
 
-    The terms of docs/model.md §3's condition m_A > (m_τ + m_ν) c_e²‖γ‖²: numbers,
-    and the booleans ``holds`` and ``step_energy_convex``."""
+    The terms of docs/model.md §3's condition m_A > (m_τ + m_ν) c_e²‖γ‖²: numbers
+    (null where they do not exist: a body held by contact), the booleans
+    ``holds`` and ``step_energy_convex``, and the list ``held_by_contact``."""
     small = problem.smallness
     if small is None:
         return None
-    return {key: (bool(value) if isinstance(value, (bool, np.bool_)) else json_number(value))
-            for key, value in small.items()}
+
+    def plain_value(value):
+        if value is None or isinstance(value, list):
+            return value
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        return json_number(value)
+    return {key: plain_value(value) for key, value in small.items()}
 
 
 def energy_record(solution):

@@ -357,8 +357,12 @@ BAD_SCENES = [
     ("steps zero", {"time.steps": 0}, "time.steps"),
     ("prony tau", {"memory": prony((200.0, 0.3, 0.0))}, "memory.terms[0].tau"),
     ("unknown side", {"boundary.dirichlet": ["middle"]}, "boundary.dirichlet"),
-    ("held by glue only", {"boundary.dirichlet": []},
-     'boundary.dirichlet: must list at least one side: nothing holds the body; the glue'),
+    ("held by a frictionless layer only", {"boundary.dirichlet": []},
+     'boundary: the held sides (none) and the contact terms on Γ_C (a normal law, a wall) '
+     'leave the body free to move rigidly (translation along x)'),
+    ("held by nothing", {"boundary.dirichlet": [], "contact": DELETE},
+     'boundary.dirichlet: must list at least one side: nothing holds the body; '
+     'boundary.contact (bottom) carries no contact terms'),
     ("disallowed name", {"loads.body": ["0", "__import__('os')"]}, "loads.body[1]"),
     ("attribute access", {"loads.body": ["0", "t.real"]}, "loads.body[1]"),
     ("probe outside", {"output.probes": [[1.0, 0.0], [5.0, 0.5]]}, "output.probes[1]"),

@@ -114,9 +114,9 @@ def test_bad_displacement_tables_name_the_key(changes, message):
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_a_body_held_only_by_glue_is_told_what_to_hold_and_the_advice_works(dim):
-    base = scene_dict({"boundary.dirichlet": [], "contact.normal": {
-        "law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01}})
+def test_a_body_held_by_nothing_is_told_what_to_hold_and_the_advice_works(dim):
+    # Γ_C listed, but [contact] sets no contact term: nothing holds the body
+    base = scene_dict({"boundary.dirichlet": []})
     if dim == 3:
         base = scene_dict({"dim": 3, "mesh.domain": "box", "mesh.size": [2.0, 0.5, 0.5],
                            "mesh.cells": [4, 2, 2]}, base)
@@ -125,8 +125,8 @@ def test_a_body_held_only_by_glue_is_told_what_to_hold_and_the_advice_works(dim)
     message = str(err.value)
     assert "\n" not in message
     assert message.startswith("boundary.dirichlet: must list at least one side: nothing "
-                              "holds the body; the glue of boundary.contact (bottom) cannot "
-                              "hold it alone")
+                              "holds the body; boundary.contact (bottom) carries no contact "
+                              "terms")
     held = ", ".join(['"0"'] * (dim - 1) + ['"0.01*t"'])
     assert 'boundary.dirichlet = ["left"]' in message
     assert f"[boundary.displacement], e.g. left = [{held}]" in message
@@ -136,6 +136,25 @@ def test_a_body_held_only_by_glue_is_told_what_to_hold_and_the_advice_works(dim)
                        base)
     problem = build_problem(scene_from_dict(moved))
     assert problem.prescribed.fixed.size == dim * np.isclose(problem.mesh.p[0], 0).sum()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_glue_without_friction_leaves_the_tangential_translations_free(dim):
+    # a normal law restrains the normal translation and the rotations that
+    # tilt Γ_C, not a slide along it (nor, in 3D, the turn about its normal)
+    base = scene_dict({"boundary.dirichlet": [], "contact.normal": {
+        "law": "adhesive_compliance", "c": 1e4, "gamma": 5e3, "L": 0.01}})
+    if dim == 3:
+        base = scene_dict({"dim": 3, "mesh.domain": "box", "mesh.size": [2.0, 0.5, 0.5],
+                           "mesh.cells": [4, 2, 2]}, base)
+    with pytest.raises(SceneError) as err:
+        build_problem(scene_from_dict(base))
+    free = ("translation along x" if dim == 2 else
+            "translation along x, translation along z, rotation about the axis along y "
+            "through (1, 0.25, 0.25)")
+    assert str(err.value).startswith(
+        "boundary: the held sides (none) and the contact terms on Γ_C (a normal law) leave "
+        f"the body free to move rigidly ({free}): ")
 
 
 def test_a_contact_node_with_a_held_component_stays_on_contact():

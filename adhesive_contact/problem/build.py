@@ -11,6 +11,8 @@ its part of the :class:`~.problem.Problem`:
 4. :func:`manufactured_solution`: for a scene with [exact], its derived data;
 5. :func:`contact`: Γ_C (only if the scene has contact terms), the step's
    unknowns and the gap at the contact nodes for every t_n;
+   :func:`restraint`: no rigid motion left free by the held sides and the
+   contact terms together;
 6. :func:`initial_bonding`: β_0^h = P_B β_0 (and the source s_β of a
    manufactured solution);
 7. :func:`loads`: the load map of f_0 and f_N (or of a manufactured
@@ -35,7 +37,7 @@ from ..fem.contact_boundary import (
     facet_points,
     tangent_frame,
 )
-from ..fem.dirichlet import prescribed_displacement
+from ..fem.dirichlet import prescribed_displacement, rigid_modes
 from ..fem.foundation import foundation_gap, foundation_normal
 from ..fem.meshes import build_mesh, named_facets
 from ..laws import make_bonding, make_friction, make_normal_law
@@ -51,6 +53,10 @@ from .checks import (
     check_outside_foundation,
     check_prescribed,
     check_probes,
+    check_rigid_motions,
+    describe_motions,
+    free_rigid_motions,
+    restraining_rows,
 )
 from .problem import Problem
 
@@ -66,6 +72,7 @@ def build_problem(scene):
     laws = contact_laws(scene)
     exact = manufactured_solution(scene, mesh, laws, times, held)
     on_contact = contact(scene, mesh, assembly, held, laws, times)
+    held_by_contact = restraint(scene, mesh, held, laws, on_contact)
     beta0, beta_source = initial_bonding(scene, mesh, on_contact.boundary, exact)
     probe_map = probes(scene, mesh)
     return Problem(scene=scene, mesh=mesh, assembly=assembly, free=held.free,
@@ -75,7 +82,7 @@ def build_problem(scene):
                    beta0=beta0, normal_law=laws.normal, friction=laws.friction,
                    bonding=laws.bonding, probe_map=probe_map, times=times,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
-                   beta_source=beta_source)
+                   beta_source=beta_source, held_by_contact=held_by_contact)
 
 
 # ---------------------------------------------------------------- 1. mesh and dofs
@@ -102,8 +109,8 @@ class HeldDofs:
 
 
 def held_dofs(scene, mesh, assembly):
-    """The held dofs of ``[boundary]`` (checked: consistent, no rigid motion
-    left free) and the free dofs, numbered."""
+    """The held dofs of ``[boundary]`` (checked consistent) and the free
+    dofs, numbered."""
     dirichlet_facets = named_facets(mesh, scene.dirichlet, "boundary.dirichlet")
     contact_facets = named_facets(mesh, scene.contact_sides, "boundary.contact")
     prescribed = prescribed_displacement(scene, mesh)
@@ -194,6 +201,33 @@ def contact(scene, mesh, assembly, held, laws, times):
     positions = held.position[boundary.frame_dofs.ravel()[columns]]
     gap = gap_at_nodes(scene, mesh, boundary, times) if scene.contact.has_wall else None
     return Contact(boundary, columns, positions, gap)
+
+
+def restraint(scene, mesh, held, laws, on_contact):
+    """Refuse a rigid motion that neither the held sides nor the contact
+    terms restrain (:func:`~.checks.check_rigid_motions`): a normal law
+    restrains a motion that moves Γ_C along its normal somewhere, the wall
+    one that moves a node with a wall along its normal, friction one that
+    moves Γ_C tangentially (docs/model.md, 'A body held by contact').
+
+    Returns the rigid motions the held sides leave free, which the contact
+    terms hold alone, in words (() when the held sides hold every one)."""
+    fixed, sides = held.prescribed.fixed, held.prescribed.sides
+    boundary = on_contact.boundary
+    modes = rigid_modes(mesh.p)
+    if boundary is None:
+        check_rigid_motions(mesh, fixed, sides)
+        return ()
+    normal = bool(laws.normal.active)
+    wall = (np.isfinite(on_contact.gap).any(axis=0) if on_contact.gap is not None
+            else np.zeros(boundary.nodes.size, dtype=bool))
+    tangential = laws.friction is not None
+    terms = [name for name, acts in (("a normal law", normal), ("a wall", wall.any()),
+                                     ("friction", tangential)) if acts] or ["none"]
+    rows = restraining_rows(modes, boundary, normal, wall, tangential)
+    check_rigid_motions(mesh, fixed, sides, (rows, ", ".join(terms)))
+    free = free_rigid_motions(modes, fixed)
+    return tuple(describe_motions(free, mesh.p)) if free.shape[1] else ()
 
 
 def gap_at_nodes(scene, mesh, boundary, times):

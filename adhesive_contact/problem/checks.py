@@ -23,8 +23,9 @@ time grid, and the exact solution at the mesh nodes; ``build_problem``
 calls them, since the points come from the geometry.
 
 Held sides. :func:`check_prescribed`: sides that share a dof prescribe one
-value there, a held component of a scene with [exact] equals u*, and the
-held components leave no rigid motion free (:func:`check_rigid_motions`).
+value there, a held component of a scene with [exact] equals u*.
+:func:`check_rigid_motions`: the held components and the contact terms
+leave no rigid motion free (docs/model.md, 'A body held by contact').
 
 Geometry. :func:`check_gap`, :func:`check_outside_foundation`,
 :func:`check_beta0` and :func:`check_probes`.
@@ -118,12 +119,11 @@ def check_prescribed(prescribed, scene, mesh):
     """The held components of a scene (a
     :class:`~adhesive_contact.fem.dirichlet.PrescribedDisplacement`) are
     consistent: one value at every dof held by several sides, u* on the
-    held sides of a scene with [exact], no rigid motion left free."""
+    held sides of a scene with [exact]."""
     times = scene.k * np.arange(scene.steps + 1)
     _check_agreement(prescribed.entries, prescribed.fixed, prescribed.count, mesh, times)
     if scene.exact is not None:
         _check_exact_held(prescribed.entries, scene, mesh, times)
-    check_rigid_motions(mesh, prescribed.fixed, prescribed.sides)
 
 
 def _check_agreement(rows, fixed, count, mesh, times):
@@ -168,34 +168,160 @@ def _check_exact_held(rows, scene, mesh, times):
                                  f"with [exact] (differs at t = {t:g})")
 
 
-_MOTIONS = {2: ("translation along x", "translation along y", "rotation"),
-            3: ("translation along x", "translation along y", "translation along z",
-                "rotation about x", "rotation about y", "rotation about z")}
+def free_rigid_motions(modes, fixed):
+    """An orthonormal basis (nmodes, k) of the rigid motions (coordinates in
+    the columns of ``modes``, :func:`~adhesive_contact.fem.dirichlet.rigid_modes`)
+    that vanish at the held dofs ``fixed``: those the held sides leave free."""
+    return _null_space(modes[fixed], modes.shape[1])
 
 
-def check_rigid_motions(mesh, fixed, sides):
-    """Refuse held dofs ``fixed`` that leave a rigid motion of the body free:
-    the rank of the rigid modes restricted to them must be 3 in 2D (two
-    translations and the rotation) and 6 in 3D."""
-    d = mesh.dim()
+def _null_space(B, n, rtol=1e-8):
+    """An orthonormal basis (n, k) of the null space of B (m, n)."""
+    if B.shape[0] == 0 or n == 0:
+        return np.eye(n)
+    _, sv, vt = np.linalg.svd(B, full_matrices=True)
+    rank = int((sv > rtol * max(sv[0], 1e-300)).sum()) if sv.size else 0
+    return vt[rank:].T
+
+
+def restraining_rows(modes, boundary, normal, wall, tangential):
+    """The rows (m, nmodes) through which the contact terms see a rigid
+    motion: u_ν of the motion at the quadrature points of Γ_C where a normal
+    law acts (``normal``), its nodal u_ν where the wall acts (``wall``, a
+    bool per contact node: a finite gap), and u_τ at the points where a
+    friction law acts (``tangential``). A motion these rows map to zero
+    changes none of the contact terms: nothing restrains it.
+
+    Parameters
+    ----------
+    modes : (ndofs, nmodes), the rigid motions at every dof
+    boundary : ContactBoundary
+    normal, tangential : bool, whether a normal law / a friction law acts
+    wall : (nc,) bool
+    """
+    d = boundary.dim
+    at_nodes = modes[boundary.dofs.ravel()].reshape(boundary.nodes.size, d, -1)
+    # the frame components z_a = R_aᵀ m_a of each motion, node-major (nc·d, nmodes)
+    z = np.einsum("aic,aim->acm", boundary.frame, at_nodes).reshape(-1, modes.shape[1])
+    rows = []
+    if normal:
+        rows.append(boundary.normal_trace @ z)
+    if np.any(wall):
+        rows.append(z[np.flatnonzero(wall) * d])
+    if tangential:
+        rows += [trace @ z for trace in boundary.tangential_trace]
+    return np.concatenate(rows) if rows else np.zeros((0, modes.shape[1]))
+
+
+def check_rigid_motions(mesh, fixed, sides, contact=None):
+    """Refuse a scene that leaves a rigid motion of the body free: one that
+    vanishes at the held dofs ``fixed`` and, with ``contact`` (the rows of
+    :func:`restraining_rows` and a phrase naming the contact terms), changes
+    none of the contact terms. The message lists exactly the motions left
+    free (:func:`describe_motions`)."""
     modes = rigid_modes(mesh.p)
-    held = modes[fixed]
-    nmodes = modes.shape[1]
-    if fixed.size:
-        _, sv, vt = np.linalg.svd(held, full_matrices=True)
-        rank = int((sv > 1e-8 * sv[0]).sum()) if sv.size else 0
-    else:
-        rank, vt = 0, np.eye(nmodes)
-    if rank == nmodes:
+    free = free_rigid_motions(modes, fixed)
+    if contact is not None and free.shape[1]:
+        rows, terms = contact
+        free = free @ _null_space(rows @ free, free.shape[1])
+    if free.shape[1] == 0:
         return
-    free_modes = vt[rank:]                 # the rigid motions the held dofs leave
-    names = [name for k, name in enumerate(_MOTIONS[d])
-             if np.abs(free_modes[:, k]).max() > 1e-6]
-    raise SceneError("boundary", "the held sides (" + (", ".join(sides) or "none") + ") leave "
-                     "the body free to move rigidly (" + ", ".join(names) + "): hold more "
-                     "components, e.g. list a side in boundary.dirichlet or give \"0\" for "
-                     "the missing component on a side of [boundary.displacement] (a single "
-                     "held point does not stop a rotation: hold a component along a side)")
+    motions = describe_motions(free, mesh.p)
+    held = ", ".join(sides) or "none"
+    if contact is None:
+        start = f"the held sides ({held}) leave the body free to move rigidly"
+        cure = ""
+    else:
+        start = (f"the held sides ({held}) and the contact terms on Γ_C ({contact[1]}) "
+                 "leave the body free to move rigidly")
+        cure = (", or add a contact term that restrains it (friction a tangential motion, "
+                "a normal law or a wall a normal one)")
+    raise SceneError("boundary", f"{start} ({', '.join(motions)}): hold more components, "
+                     "e.g. list a side in boundary.dirichlet or give \"0\" for the missing "
+                     f"component on a side of [boundary.displacement]{cure} (a single held "
+                     "point does not stop a rotation: hold a component along a side)")
+
+
+_AXES = "xyz"
+
+
+def _direction(v, digits=3):
+    """'x' for ±e_x (likewise y, z), else the unit vector's components."""
+    v = v / np.linalg.norm(v)
+    k = int(np.argmax(np.abs(v)))
+    if abs(abs(v[k]) - 1.0) < 1e-8:
+        return _AXES[k]
+    v = v * np.sign(v[k])
+    return "(" + ", ".join(f"{c:.{digits}g}" for c in v) + ")"
+
+
+def _point(p, scale):
+    """A point's coordinates, round-off below 1e-10 of the body's size shown as 0."""
+    p = np.where(np.abs(p) < 1e-10 * scale, 0.0, p)
+    return "(" + ", ".join(f"{c + 0.0:.4g}" for c in p) + ")"
+
+
+def describe_motions(free, points):
+    """The rigid motions of the span of ``free`` (nmodes, k), coordinates of
+    :func:`~adhesive_contact.fem.dirichlet.rigid_modes` at ``points``
+    (d, m), in words, one per dimension of the span: first the
+    translations in it, then its rotations, each about the point (2D) or
+    the axis (3D) nearest the centroid; "rotation" alone when every
+    translation is free too (any centre will do)."""
+    d = points.shape[0]
+    centre = points.mean(axis=1)
+    scale = max(np.abs(points - centre[:, None]).max(), 1e-300)
+    t, w = free[:d], free[d:] / scale   # u(x) = t + W (x − centre), W of w
+    nrot = w.shape[0]
+    only_translations = _null_space(w, free.shape[1])   # (k, kt)
+    translations = _orthonormal(t @ only_translations)
+    words = [f"translation along {_direction(e)}" for e in translations.T]
+    rest = (_null_space(only_translations.T, free.shape[1]) if only_translations.shape[1]
+            else np.eye(free.shape[1]))
+    if rest.shape[1] == 0:
+        return words
+    tr, wr = t @ rest, w @ rest
+    # remove from each rotation the free translations (centre nearest the centroid)
+    tr = tr - translations @ (translations.T @ tr) if translations.size else tr
+    every = translations.shape[1] == d
+    if d == 2:
+        omega = wr[0, 0]
+        if every:
+            return words + ["rotation"]
+        p = centre + np.array([-tr[1, 0], tr[0, 0]]) / omega
+        return words + [f"rotation about {_point(p, scale)}"]
+    axes = _orthonormal(wr)
+    if every:
+        return words + [f"rotation about {_direction(a)}" for a in axes.T]
+    for a in axes.T:
+        # the motion of this axis: the combination of rest whose w is a
+        combo = np.linalg.lstsq(wr, a, rcond=None)[0]
+        tv = tr @ combo
+        p = centre + np.cross(a, tv)          # the point of the axis nearest the centre
+        pitch = float(tv @ a)
+        word = f"rotation about the axis along {_direction(a)} through {_point(p, scale)}"
+        if abs(pitch) > 1e-8 * max(np.linalg.norm(tv), 1.0) * scale:
+            word += f" with a shift {pitch:.3g} along it per radian"
+        words.append(word)
+    return words
+
+
+def _orthonormal(v, rtol=1e-8):
+    """An orthonormal basis of the span of the columns of v (d, k)."""
+    if v.size == 0:
+        return np.zeros((v.shape[0], 0))
+    u, sv, _ = np.linalg.svd(v, full_matrices=False)
+    keep = sv > rtol * max(sv[0], 1e-300)
+    basis = u[:, keep]
+    # prefer the coordinate axes when the span holds them (e.g. x and y, not their mix)
+    picked = []
+    for e in np.eye(v.shape[0]):
+        inside = basis @ (basis.T @ e)
+        if np.linalg.norm(inside - e) < 1e-8:
+            picked.append(e)
+    if len(picked) == basis.shape[1]:
+        return np.stack(picked, axis=1)
+    return basis
 
 
 # ---------------------------------------------------------------- geometry

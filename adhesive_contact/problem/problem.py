@@ -39,6 +39,7 @@ class Problem:
     assembly_seconds: float
     exact: object = None      # ManufacturedSolution, for scenes with [exact]
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
+    held_by_contact: tuple = ()  # the rigid motions only the contact terms hold, in words
     _smallness: dict = field(default=None, repr=False)
 
     @property
@@ -46,7 +47,8 @@ class Problem:
         """The terms of docs/model.md §3's condition (None without contact),
         computed on first use (a generalised eigenproblem) and kept."""
         if self._smallness is None and self.boundary is not None:
-            self._smallness = smallness(self.scene, self.normal_law, self.friction)
+            self._smallness = smallness(self.scene, self.normal_law, self.friction,
+                                        self.held_by_contact)
         return self._smallness
 
     def warnings(self):

@@ -115,20 +115,33 @@ def _trace_constant(mesh_spec, dirichlet, contact_sides):
     return float(vals[0])
 
 
-def smallness(scene, normal_law, friction):
+def smallness(scene, normal_law, friction, held_by_contact=()):
     """The terms of the conditions as a JSON-able dict: ``holds`` (the error
     estimate's), ``existence_holds``, ``step_energy_convex``, their right-hand
-    sides, and the mesh the trace constant comes from."""
+    sides, and the mesh the trace constant comes from.
+
+    With rigid motions that only the contact terms hold (``held_by_contact``,
+    in words) ‖ε(v)‖ is no norm on V and c_e‖γ‖ is infinite: the conditions
+    do not hold, their right-hand sides and the trace constant are None,
+    ``held_by_contact`` lists the motions, and a step's energy is convex
+    when the friction is (m_c = 0: S is positive semidefinite, docs/model.md
+    'A body held by contact')."""
     lam, mu = scene.material.lam, scene.material.mu
     m_A = min(2.0 * mu, scene.dim * lam + 2.0 * mu)
     m_nu = float(normal_law.lipschitz)
     m_tau = 0.0 if friction is None else float(friction.m_tau)
     c_1 = 0.0 if friction is None else float(friction.c_1)
+    m_c = 0.0 if friction is None else float(friction.nonconvexity)
+    if held_by_contact:
+        return {"m_A": m_A, "m_nu": m_nu, "m_tau": m_tau, "trace_constant_squared": None,
+                "rhs": None, "holds": False, "c_1tau": c_1, "existence_rhs": None,
+                "existence_holds": False, "nonconvexity": m_c, "convexity_rhs": None,
+                "step_energy_convex": bool(m_c == 0.0), "trace_refine": None,
+                "trace_lower_estimate": False, "held_by_contact": list(held_by_contact)}
     refine = trace_mesh_refine(scene) if scene.contact_sides else 0
     ce2 = trace_constant_squared(scene, refine) if scene.contact_sides else 0.0
     rhs = (m_tau + m_nu) * ce2
     existence = (max(np.sqrt(3.0) * c_1, m_tau) + m_nu) * ce2
-    m_c = 0.0 if friction is None else float(friction.nonconvexity)
     return {"m_A": m_A, "m_nu": m_nu, "m_tau": m_tau, "trace_constant_squared": ce2,
             "rhs": rhs, "holds": bool(m_A > rhs),
             "c_1tau": c_1, "existence_rhs": existence, "existence_holds": bool(m_A > existence),

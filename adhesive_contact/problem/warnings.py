@@ -36,6 +36,12 @@ def smallness_warning(problem):
     s = problem.smallness
     if s is None or s["holds"]:
         return None
+    if s.get("held_by_contact"):
+        return (f"only the contact terms hold the body against "
+                f"{', '.join(s['held_by_contact'])}: the smallness conditions (which need "
+                f"the held sides to stop every rigid motion) do not apply, and a load those "
+                f"terms cannot balance has no equilibrium "
+                f"(docs/model.md#a-body-held-by-contact)")
     tail = ("each step still has one solution (its energy is convex)"
             if s["step_energy_convex"] else
             "a step may have several solutions and the solver may pick any or fail")

@@ -17,7 +17,7 @@ from .keys import MAX_TITLE, declared
 from .materials import check_relaxation_step, instantaneous, read_material, read_memory
 from .reader import Table
 from .spec import Scene
-from .tables import (read_boundary, read_exact, read_loads, read_mesh, read_output,
+from .tables import (check_something_holds, read_boundary, read_exact, read_loads, read_mesh, read_output,
                      read_solver, read_time)
 
 
@@ -54,8 +54,10 @@ def scene_from_dict(data, base_dir=None):
     top.finish()
     if memory is not None and memory.kernel == "relaxation":
         check_relaxation_step(memory, dim, T / steps)
-    return Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
-                 traction, contact, T, steps, solver, probes, exact, displacement, units)
+    scene = Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
+                  traction, contact, T, steps, solver, probes, exact, displacement, units)
+    check_something_holds(scene, by_file)
+    return scene
 
 
 def parse_scene(text, base_dir=None):

@@ -87,16 +87,14 @@ def _read_mesh_file(table, dim, base_dir, refine):
 
 def read_boundary(table, dim, named_by_file=False):
     """(Dirichlet sides, contact sides, {side: prescribed displacement}):
-    the Dirichlet, displacement and contact sides are disjoint; at least
-    one side holds the body (whether it holds it against every rigid motion
-    is checked with the geometry, when the problem is built)."""
+    the Dirichlet, displacement and contact sides are disjoint. Whether
+    something holds the body is checked once [contact] is read
+    (:func:`check_something_holds`), and whether it holds it against every
+    rigid motion with the geometry, when the problem is built."""
     dirichlet = _read_sides(table, "dirichlet", dim, named_by_file)
     contact_sides = _read_sides(table, "contact", dim, named_by_file)
     displacement = _read_displacement(table.table("displacement"), dim, named_by_file)
     table.finish()
-    if not dirichlet and not displacement:
-        raise SceneError("boundary.dirichlet", _nothing_holds(contact_sides, dim,
-                                                              named_by_file))
     both = set(dirichlet) & set(contact_sides)
     if both:
         raise SceneError("boundary.contact", f"side {sorted(both)[0]!r} is also Dirichlet; "
@@ -107,6 +105,15 @@ def read_boundary(table, dim, named_by_file=False):
                              f"{'Dirichlet' if side in dirichlet else 'contact'} side; the "
                              "parts of the boundary must be disjoint")
     return dirichlet, contact_sides, displacement
+
+
+def check_something_holds(scene, named_by_file=False):
+    """A body with no held side must be held by its contact terms (a wall,
+    a normal law, friction on Γ_C): refuse one that has neither."""
+    if scene.dirichlet or scene.displacement or scene.has_contact_terms:
+        return
+    raise SceneError("boundary.dirichlet", _nothing_holds(scene.contact_sides, scene.dim,
+                                                          named_by_file))
 
 
 def _read_sides(table, name, dim, named_by_file):
@@ -127,18 +134,17 @@ def _read_sides(table, name, dim, named_by_file):
 
 
 def _nothing_holds(contact_sides, dim, named_by_file):
-    """The message for a body no side holds: the model needs |Γ_D| > 0, and
-    glue (boundary.contact) alone does not hold a body; what to write instead."""
+    """The message for a body that no side and no contact term holds; what
+    to write instead."""
     free = [s for s in SIDES[dim] if s not in contact_sides]
     side = "SIDE" if named_by_file or not free else free[0]
-    glue = (f"; the glue of boundary.contact ({', '.join(contact_sides)}) cannot hold it "
-            "alone" if contact_sides else "")
+    glue = (f"; boundary.contact ({', '.join(contact_sides)}) carries no contact terms "
+            "([contact] sets no wall, normal law or friction)" if contact_sides else "")
     held = ", ".join(['"0"'] * (dim - 1) + ['"0.01*t"'])
     rollers = ", ".join(['"0"'] + ['"free"'] * (dim - 1))
-    return (f"must list at least one side: nothing holds the body{glue} (the model needs "
-            f"|Γ_D| > 0); clamp a side with boundary.dirichlet = [\"{side}\"], or "
-            f"prescribe one in [boundary.displacement], e.g. {side} = [{held}] (\"free\" "
-            f"leaves a component free, as rollers {side} = [{rollers}] do; the held "
+    return (f"must list at least one side: nothing holds the body{glue}; clamp a side "
+            f"with boundary.dirichlet = [\"{side}\"], or prescribe one in "
+            f"[boundary.displacement], e.g. {side} = [{held}] (\"free\" leaves a component free, as rollers {side} = [{rollers}] do; the held "
             "components must stop every rigid motion)")
 
 

@@ -81,8 +81,8 @@ def march(problem, operators, contact, recorder, state, progress=None):
             level, u, frame_u, z, result = step_solve(problem, operators, contact, n, t, b,
                                                       beta, history, state.z,
                                                       state.z_before)           # (4.1)
-            failure = StepFailure(n, t, result) if level is None else check_level(problem,
-                                                                                  level)
+            failure = (StepFailure(n, t, result, problem.held_by_contact) if level is None
+                       else check_level(problem, level))
             if failure is not None and failure.result is None:
                 failure.result = result   # an invalid state: the solve that gave it
         if failure is not None:

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..linear_solvers import choose, make_linear_solver
-from .condensed import CondensedOperator, PartialCondensation
+from .condensed import CondensedOperator, DenseSchur, PartialCondensation
 from .full_system import FullSystemOperator
 
 #: the step methods that iterate on all free dofs with AMG (scheme/full_system.py).
@@ -138,12 +138,25 @@ class StepOperators:
             A = coupled(lam, mu)[free][:, free]
             if unreduced:
                 return FullSystemOperator(A, contact, factorise=factorise, solver=nearby)
+            # a body held by contact: S is singular along the free rigid motions,
+            # and a partial factorisation (PARDISO's) stops at its zero pivot.
+            # δ I on the contact block changes S by exactly δ I and nothing else
+            # (a_II, and so reduce and expand, do not see it): factorise A + δ I_C
+            # and take δ I back off S (docs/scheme.md, 'A body held by contact')
+            delta = (float(A.diagonal()[contact].max())
+                     if problem.held_by_contact and contact.size else 0.0)
+            if delta:
+                A = (A + sp.coo_matrix((np.full(contact.size, delta), (contact, contact)),
+                                       shape=A.shape)).tocsr()
             if method == "pardiso" and contact.size:   # S and the solve halves in one
                 operator = PartialCondensation(A, contact)
                 operator.solver.reason = reason
-                return operator
-            return CondensedOperator(A, contact, factorise=factorise,
-                                     approximation=nearby)
+            else:
+                operator = CondensedOperator(A, contact, factorise=factorise,
+                                             approximation=nearby)
+            if delta:
+                unshift(operator, delta)
+            return operator
 
         material = problem.scene.material
         elastic = (material.lam, material.mu)
@@ -209,6 +222,16 @@ class StepOperators:
     def from_frames(self, u_frame):
         """Cartesian components u = R ũ of a nodal-frame vector (ndofs,)."""
         return self.rotation @ u_frame if self.rotation is not None else u_frame
+
+
+def unshift(operator, delta):
+    """S − δ I in place of the S of a condensed ``operator`` whose contact
+    block was shifted by δ I (formed: the dense matrix; applied: its A_CC)."""
+    S = operator.S
+    if isinstance(S, DenseSchur):
+        operator.S = DenseSchur(S.matrix - delta * np.eye(S.shape[0]))
+    else:
+        S.A_CC = (S.A_CC - delta * sp.eye(S.shape[0], format="csr")).tocsr()
 
 
 def contraction(tensor, shift, dim):

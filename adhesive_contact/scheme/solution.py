@@ -9,18 +9,28 @@ SUCCESS, STEP_FAILED, STOPPED = 0, 1, 2
 
 
 class StepFailure(RuntimeError):
-    """A step solve that did not converge; carries the step and its result."""
+    """A step solve that did not converge; carries the step and its result.
+    ``held_by_contact``: the rigid motions only the contact terms hold (in
+    words), whose load may exceed what they can hold."""
 
-    def __init__(self, n, t, result):
+    def __init__(self, n, t, result, held_by_contact=()):
         self.n, self.t, self.result = n, t, result
+        self.held_by_contact = tuple(held_by_contact)
+        advice = ("Try more time steps (smaller k), a larger solver.max_iter, or check the "
+                  "smallness condition of the contact laws")
+        if self.held_by_contact:
+            advice = (f"Only the contact terms hold the body against "
+                      f"{', '.join(self.held_by_contact)}: a load they cannot balance (one "
+                      "that pulls Γ_C off a layer without glue, or shears it past the friction "
+                      "bound times |Γ_C|) has no equilibrium; check the load, or hold more "
+                      "components. Else t" + advice[1:])
         super().__init__(
             f"step {n} (t = {t:g}) did not converge: {result.message}; projected "
             f"residual reached {result.residual:.2e} (tolerance {result.tolerance:.1e}) "
-            f"after {result.nit} iterations. Try more time steps (smaller k), a larger "
-            f"solver.max_iter, or check the smallness condition of the contact laws")
+            f"after {result.nit} iterations. {advice}")
 
     def __reduce__(self):   # survive pickling back from a worker process
-        return (type(self), (self.n, self.t, self.result))
+        return (type(self), (self.n, self.t, self.result, self.held_by_contact))
 
 
 @dataclass
