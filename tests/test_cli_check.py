@@ -39,8 +39,10 @@ def test_check_refuses_a_bad_scene_with_one_line(tmp_path):
 
 
 def test_quiet_solve_prints_no_warning_but_keeps_them(tmp_path):
-    # the debonding scene warns (its smallness condition fails)
-    path = ROOT / "studies/scenes/debonding.toml"
+    # a contact stiffness 1e12 times the body's warns
+    path = tmp_path / "stiff.toml"
+    path.write_text(to_toml(scene_dict({"contact.normal": {"law": "compliance", "c": 1e12},
+                                        "time.steps": 2})))
     out = tmp_path / "out"
     loud = CliRunner().invoke(main, ["solve", str(path), "--out", str(tmp_path / "loud")])
     quiet = CliRunner().invoke(main, ["solve", str(path), "--out", str(out), "--quiet"])

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.quantities import beta_mean
 from ..postprocess.states import contact_state_counts
+from ..problem.warnings import solution_warnings
 from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 
@@ -211,8 +212,9 @@ def run_variant(document, values):
     ``compliance_T``, ``stick_T``, ``slip_T`` (None without friction) and
     ``normal_force_T`` (the total normal force of Γ_C on the body, positive
     in compression); ``max_un_minus_g`` is max over all levels and contact
-    nodes of u_ν − g (None without a wall). A failed run has None for what
-    needs the solution.
+    nodes of u_ν − g (None without a wall); ``warnings`` what the solution
+    shows (:func:`~adhesive_contact.problem.warnings.solution_warnings`).
+    A failed run has None for what needs the solution.
     """
     t0 = time.perf_counter()
     problem = build_problem(scene_from_dict(variant_document(document, values)))
@@ -237,7 +239,8 @@ def run_variant(document, values):
         "max_un_minus_g": solution.gap_violation().max(),
         **{f"{key}_T": states.get(key) for key in ("separated", "on_wall", "compliance",
                                                   "stick", "slip")},
-        "normal_force_T": solution.total_normal_force()[-1]})
+        "normal_force_T": solution.total_normal_force()[-1],
+        "warnings": solution_warnings(solution)})
 
 
 def _setup(document, runs):
