@@ -20,6 +20,7 @@ from .common import load_scene, read_scene, scene_folder
               help="Also print the resolved scene (every default filled in) as JSON.")
 def check(scene, resolved):
     """Validate SCENE (the built-in default if omitted) and print what a run would be."""
+    from adhesive_contact.problem.plausibility import prony_note
     from adhesive_contact.resources import built_counts, estimate
     from adhesive_contact.storage import plain
 
@@ -46,6 +47,9 @@ def check(scene, resolved):
                    f"{small['rhs']:.4g} ({'holds' if small['holds'] else 'does not hold'}); "
                    f"step energy {'convex' if small['step_energy_convex'] else 'may be nonconvex'}"
                    f" (m_c c_e^2 = {small['convexity_rhs']:.4g})")
+    note = prony_note(parsed)
+    if note:
+        click.echo(f"  note: {note}")
     for warning in problem.warnings():
         click.echo(f"  warning: {' '.join(str(warning).split())}")
     if resolved:

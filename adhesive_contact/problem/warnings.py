@@ -4,7 +4,9 @@ Nothing here raises (refusals are :mod:`.checks`). Before a run,
 :func:`problem_warnings` says what the scene's numbers make likely to go
 wrong: a step beyond the explicit Euler bound of the bonding law, and a
 contact stiffness many orders of magnitude away from the body's (the step
-matrix is then ill-conditioned, or the contact law irrelevant);
+matrix is then ill-conditioned, or the contact law irrelevant), and the
+material data the discretisation or physics cannot bear (:mod:`.plausibility`:
+ν near ½ with P1 elements, a modulus no solid has in the named units);
 ``adhcontact solve``, ``check`` and ``sweep`` show them. The theory's
 smallness conditions (docs/model.md §3) are no warning: they are
 sufficient conditions that realistic adhesive scenes miss by orders of
@@ -18,8 +20,16 @@ linear, small-strain model represents.
 
 import numpy as np
 
-#: the largest displacement allowed, as a fraction of the body's size
-DISPLACEMENT_FRACTION = 0.1
+from .plausibility import plausibility_warnings
+
+#: the largest principal strain |ε| the small-strain model is taken to represent
+STRAIN_LIMIT = 0.1
+#: the largest gap between the linear strain ε(u) and the Green–Lagrange strain
+#: ε(u) + ½ ∇uᵀ∇u (its quadratic part; 1 − cos θ for a rotation by θ: 18°)
+GREEN_LAGRANGE_GAP = 0.05
+#: the share of the body's volume beyond either limit that makes a warning
+#: (a single cell at a singular corner or a debonding front makes none)
+VOLUME_SHARE = 0.01
 #: the orders of magnitude between the contact stiffness and the body's
 STIFFNESS_ORDERS = 6
 
@@ -30,10 +40,58 @@ def body_size(problem):
     return float(np.linalg.norm(p.max(axis=1) - p.min(axis=1)))
 
 
-def largest_displacement(solution):
-    """max over levels and nodes of |u| (read one level at a time)."""
-    return max((float(np.linalg.norm(solution.u[n], axis=1).max())
-                for n in range(solution.t.size)), default=0.0)
+def gradient_measures(problem, u):
+    """Per cell of the P1 displacement ``u`` (npoints, d): the largest
+    principal strain |ε|, the rotation angle θ = asin(min(|ω|, 1)) of the
+    skew part ω of ∇u (|ω| its axial vector's length), and the largest
+    eigenvalue of the quadratic part ½ ∇uᵀ∇u of the Green–Lagrange strain.
+    Returns three (ncells,) arrays."""
+    grad_lambda, _ = problem.geometry
+    G = np.einsum("iea,eib->eab", u[problem.mesh.t], grad_lambda)   # ∂u_a/∂x_b
+    eps = 0.5 * (G + G.transpose(0, 2, 1))
+    omega = 0.5 * (G - G.transpose(0, 2, 1))
+    strain = np.abs(np.linalg.eigvalsh(eps)).max(axis=1)
+    rotation = np.arcsin(np.minimum(np.sqrt(0.5 * (omega ** 2).sum(axis=(1, 2))), 1.0))
+    quadratic = np.linalg.eigvalsh(0.5 * np.einsum("eca,ecb->eab", G, G)).max(axis=1)
+    return strain, rotation, quadratic
+
+
+def geometry_warning(solution):
+    """A line when, at some level, more than VOLUME_SHARE of the body has
+    strains above STRAIN_LIMIT or a linear strain that misses the
+    Green–Lagrange strain by more than GREEN_LAGRANGE_GAP (rotations above
+    about 18°): what the small-strain model cannot represent."""
+    problem = solution.problem
+    _, volume = problem.geometry
+    total = volume.sum()
+    worst = None
+    for n in range(solution.t.size):   # one level at a time (a streamed u is on disk)
+        strain, rotation, quadratic = gradient_measures(problem, np.asarray(solution.u[n]))
+        beyond = (strain > STRAIN_LIMIT) | (quadratic > GREEN_LAGRANGE_GAP)
+        share = volume[beyond].sum() / total
+        if share > VOLUME_SHARE and (worst is None or share > worst[0]):
+            worst = (share, n, strain, rotation, quadratic)
+    if worst is None:
+        return None
+    share, n, strain, rotation, quadratic = worst
+    cell = int(np.argmax(np.maximum(strain / STRAIN_LIMIT, quadratic / GREEN_LAGRANGE_GAP)))
+    centre = problem.mesh.p[:, problem.mesh.t[:, cell]].mean(axis=1)
+    point = "(" + ", ".join(f"{c:.3g}" for c in centre) + ")"
+    reasons, cannot = [], []
+    if strain.max() > STRAIN_LIMIT:
+        reasons.append(f"strains up to {strain.max():.3g} (more than {STRAIN_LIMIT:g})")
+        cannot.append("large strains")
+    if quadratic.max() > GREEN_LAGRANGE_GAP:
+        reasons.append(f"rotations up to {np.degrees(rotation.max()):.0f}°, where the linear "
+                       f"strain misses the Green–Lagrange strain by up to "
+                       f"{quadratic.max():.3g} (more than {GREEN_LAGRANGE_GAP:g})")
+        cannot.insert(0, "finite rotations (a rotated part stretches instead: a lifted arm "
+                         "is drawn stretched straight up)")
+    return (f"at t = {solution.t[n]:.4g}, {100 * share:.0f}% of the body is beyond the "
+            f"small-strain model, with {' and '.join(reasons)}, worst near {point}: the "
+            f"model is linear in the displacement and cannot represent "
+            f"{' nor '.join(cannot)}; the result is outside its range "
+            "(docs/conventions.md#the-model-is-small-strain)")
 
 
 def step_list(steps, times, most=8):
@@ -62,9 +120,9 @@ def nonconvex_step_warning(solution):
         return None
     return (f"the step energy is not locally strictly convex at the solution of "
             f"{step_list(steps, solution.t)}: its Newton matrix there was indefinite and "
-            "had to be modified, so the solution found may be one of several; more time "
-            "steps or a stiffer body near Γ_C make the step convex "
-            "(docs/model.md#the-three-smallness-conditions)")
+            "had to be modified, so the solution found may be one of several; softer "
+            "contact laws (a smaller friction nonconvexity) or a stiffer body make the "
+            "step convex (docs/model.md#the-three-smallness-conditions)")
 
 
 def two_solutions_warning(solution):
@@ -114,24 +172,13 @@ def stiffness_warning(problem):
                if ratio > 1 else "(the foundation barely holds the body)"))
 
 
-def displacement_warning(solution):
-    """A line when max |u| exceeds DISPLACEMENT_FRACTION of the body's size."""
-    size = body_size(solution.problem)
-    largest = largest_displacement(solution)
-    if largest <= DISPLACEMENT_FRACTION * size:
-        return None
-    return (f"the largest displacement {largest:.3g} is {100 * largest / size:.0f}% of the "
-            f"body's size {size:.3g} (more than {100 * DISPLACEMENT_FRACTION:.0f}%): the "
-            "model assumes small strains; the result is outside its range")
-
-
 def problem_warnings(problem):
     """The lines of the checks of a scene that apply, before a run."""
     return [w for w in (explicit_bound_warning(problem), stiffness_warning(problem))
-            if w is not None]
+            if w is not None] + plausibility_warnings(problem.scene)
 
 
 def solution_warnings(solution):
     """The lines of the checks of a finished run that apply."""
     return [w for w in (nonconvex_step_warning(solution), two_solutions_warning(solution),
-                        displacement_warning(solution)) if w is not None]
+                        geometry_warning(solution)) if w is not None]
