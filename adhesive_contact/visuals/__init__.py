@@ -6,7 +6,8 @@ One module per figure of a run: :mod:`.deformed` (``deformed.png``),
 (``load_displacement.png``), and :func:`write_plots` (:mod:`.solution`)
 drawing those a solution has into a folder; :mod:`.studies` draws the
 figures of a convergence study and of a sweep; :mod:`.common` holds what
-they share (:class:`Units`, titles, :func:`save_figure`).
+they share (:class:`Units`, titles, :func:`save_figure`) and :mod:`.levels`
+which time levels, axis along Γ_C and colour scales a run's figures draw.
 
 Each ``figure_*`` function returns a :class:`matplotlib.figure.Figure`
 (made with :mod:`matplotlib.pyplot`), each ``plot_*`` function saves it
@@ -25,6 +26,7 @@ from .beta import beta_space_time, figure_beta, plot_beta
 from .common import DPI, Units, plot_title, save_figure
 from .contact_map import figure_contact_map, plot_contact_map
 from .deformed import figure_deformed, magnification, plot_deformed
+from .levels import contact_axis, plot_levels
 from .load import figure_load_displacement, load_curves, plot_load_displacement
 from .solution import PLOT_NAMES, write_plots
 from .studies import (
