@@ -156,23 +156,29 @@ def _file_counts(scene):
     return nodes, cells, contact
 
 
-def estimate(scene, memory_limit=None):
+def estimate(scene, memory_limit=None, counts=None):
     """The :class:`Estimate` of a run of ``scene`` (see the module docstring).
 
     ``memory_limit`` is passed to the backend choice for ``linear = "auto"``
-    (default: its own, half the physical memory)."""
+    (default: its own, half the physical memory). ``counts`` (nodes,
+    cells, contact nodes, contact unknowns) of the mesh once built replace
+    those estimated from the scene (:func:`built_counts`)."""
     d, spec = scene.dim, scene.mesh
-    if spec.domain == "file":   # counts read off the file; refinement ×2^d (nodes ≈ cells/2^(d-1))
-        nodes, cells, contact_nodes = _file_counts(scene)
+    if counts is not None:
+        nodes, cells, contact_nodes, unknowns = counts
     else:
-        nodes = nodes_of(spec.cells, spec.refine, spec.pattern)
-        cells = (CELLS_PER_BLOCK[(spec.domain, spec.pattern)] * math.prod(spec.cells)
-                 * (2**d) ** spec.refine)
-        contact_nodes = _contact_nodes(scene)
+        if spec.domain == "file":   # read off the file; refinement ×2^d (nodes ≈ cells/2^(d-1))
+            nodes, cells, contact_nodes = _file_counts(scene)
+        else:
+            nodes = nodes_of(spec.cells, spec.refine, spec.pattern)
+            cells = (CELLS_PER_BLOCK[(spec.domain, spec.pattern)] * math.prod(spec.cells)
+                     * (2**d) ** spec.refine)
+            contact_nodes = _contact_nodes(scene)
+        # the normal component per contact node, and the tangential ones with friction
+        unknowns = (d if scene.contact is not None and scene.contact.friction
+                    else 1) * contact_nodes
     dofs = d * nodes
     nnz = d * d * PATTERN[d] * nodes
-    # the normal component per contact node, and the tangential ones with friction
-    unknowns = (d if scene.contact is not None and scene.contact.friction else 1) * contact_nodes
     levels = scene.steps + 1
     backend = scene.solver.linear
     reason = f"method {backend!r} was asked for."
@@ -209,6 +215,14 @@ def estimate(scene, memory_limit=None):
     disk = 8.0 * levels * (2 * dofs + 10 * cells)
     return Estimate(nodes, dofs, cells, contact_nodes, unknowns, levels, backend, reason,
                     float(memory), float(seconds), float(disk))
+
+
+def built_counts(problem):
+    """(nodes, cells, contact nodes, contact unknowns) of a built problem,
+    for :func:`estimate` once the mesh exists (``adhcontact check``)."""
+    boundary = problem.boundary
+    return (problem.mesh.p.shape[1], problem.mesh.t.shape[1],
+            0 if boundary is None else boundary.nodes.size, problem.columns.size)
 
 
 def _function_kernel(scene):

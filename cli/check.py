@@ -1,7 +1,9 @@
 """``adhcontact check``: validate a scene and show what a run would be,
-without running it: the resolved scene (every default filled in), the mesh
-and contact sizes, the estimate of memory, time and output, the explicit
-Euler bound of the bonding law and the smallness figures."""
+without running it: the mesh and contact sizes, the estimate of memory,
+time and output (from the mesh built: its counts are those of the mesh
+line), the explicit Euler bound of the bonding law, the smallness figures
+and the scene's warnings; with ``--resolved``, the resolved scene (every
+default filled in) as JSON."""
 
 import json
 import sys
@@ -14,14 +16,17 @@ from .common import load_scene, read_scene, scene_folder
 
 @click.command()
 @click.argument("scene", required=False, type=click.Path(dir_okay=False, path_type=Path))
-def check(scene):
+@click.option("--resolved", is_flag=True,
+              help="Also print the resolved scene (every default filled in) as JSON.")
+def check(scene, resolved):
     """Validate SCENE (the built-in default if omitted) and print what a run would be."""
-    from adhesive_contact.resources import estimate
+    from adhesive_contact.problem.plausibility import prony_note
+    from adhesive_contact.resources import built_counts, estimate
     from adhesive_contact.storage import plain
 
     name, text = read_scene(scene)
     parsed, problem = load_scene(text, scene_folder(scene), force=True)
-    est = estimate(parsed)
+    est = estimate(parsed, counts=built_counts(problem))
     boundary = problem.boundary
     click.echo(f"{name}: valid scene ({parsed.title})")
     click.echo(f"  mesh: {problem.mesh.p.shape[1]} nodes, {problem.mesh.t.shape[1]} cells, "
@@ -47,8 +52,12 @@ def check(scene):
                    f"{small['rhs']:.4g} ({'holds' if small['holds'] else 'does not hold'}); "
                    f"step energy {'convex' if small['step_energy_convex'] else 'may be nonconvex'}"
                    f" (m_c c_e^2 = {small['convexity_rhs']:.4g})")
+    note = prony_note(parsed)
+    if note:
+        click.echo(f"  note: {note}")
     for warning in problem.warnings():
         click.echo(f"  warning: {' '.join(str(warning).split())}")
-    click.echo("  resolved scene:")
-    json.dump(plain(parsed.resolved), sys.stdout, indent=1)
-    click.echo()
+    if resolved:
+        click.echo("  resolved scene:")
+        json.dump(plain(parsed.resolved), sys.stdout, indent=1)
+        click.echo()

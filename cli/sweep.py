@@ -134,6 +134,11 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
             files = list(result.files) + write_sweep_plots(
                 out, result.rows, keys, study.base.title, study.base.units, study.base.dim)
 
+    seen = [(record.get("run"), w) for record in result.records
+            for w in (record.get("warnings") or [])]
+    for warning in dict.fromkeys(w for _, w in seen):   # what the runs showed
+        runs = [str(i) for i, w in seen if w == warning]
+        click.echo(f"warning: run {', '.join(runs)}: {' '.join(warning.split())}", err=True)
     failed = sum(row["outcome"] == "failed" for row in result.rows)
     lost = len(result.lost)
     computed = len(result.computed)

@@ -1,8 +1,10 @@
 """``adhcontact check``: validates without running, prints the sizes, the
-estimate, the bonding bound and the smallness figures and the resolved
-scene, and writes nothing; a bad scene is exit 2, one line."""
+estimate (its counts those of the mesh line), the bonding bound and the
+smallness figures, the resolved scene with --resolved only, and writes
+nothing; a bad scene is exit 2, one line."""
 
 import json
+import logging
 from pathlib import Path
 
 from adhesive_contact_cli.main import main
@@ -24,9 +26,51 @@ def test_check_prints_what_a_run_would_be_and_writes_nothing(tmp_path, monkeypat
     assert "80 contact facets, 81 contact nodes, 160 contact unknowns" in out
     assert "explicit Euler bound of the bonding law: k <= 0.06667 (k = 0.02: within" in out
     assert "smallness: m_A = 769.2" in out and "estimate: " in out
-    resolved = json.loads(out[out.index("{"):])
+    assert "{" not in out and "resolved scene" not in out
+    # the estimate counts the mesh built: 160 contact unknowns as its mesh line
+    assert "891 nodes" in out and f"estimate: {2 * 891:.3g} dofs, 160 contact unknowns," in out
+    full = CliRunner().invoke(main, ["check", str(path), "--resolved"]).stdout
+    assert full.startswith(out)
+    resolved = json.loads(full[full.index("{"):])
     assert resolved == json.loads(json.dumps(load_scene(path).resolved))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_estimate_of_check_counts_the_contact_unknowns_of_its_mesh_line(tmp_path):
+    """On the built-in scene the contact unknowns of the estimate (before the
+    mesh exists: 81 bottom nodes x 2) would differ from the mesh's (each end
+    node has one component held: 79 x 2 + 2); check reports the mesh's in
+    both lines."""
+    out = CliRunner().invoke(main, ["check"]).stdout
+    assert "81 contact nodes, 160 contact unknowns" in out
+    assert "972 dofs, 160 contact unknowns, 41 time levels" in out
+
+
+def test_a_mesh_file_run_prints_nothing_of_scikit_fem(tmp_path, caplog):
+    """A 3D mesh file of more than 1000 vertices and cells, refined once:
+    scikit-fem would say it copies the arrays to C order and that the named
+    boundaries were dropped by the refinement; the library hands it
+    C-ordered arrays and refines the mesh without names."""
+    import numpy as np
+    from skfem import MeshTet
+    from test_geometry import write_msh
+
+    from adhesive_contact import build_problem, scene_from_dict
+    mesh = MeshTet.init_tensor(np.linspace(0, 2, 13), np.linspace(0, 1, 9),
+                               np.linspace(0, 0.5, 6)).with_boundaries(
+        {"bottom": lambda x: np.isclose(x[2], 0), "top": lambda x: np.isclose(x[2], 0.5)})
+    assert mesh.p.shape[1] < 1000 < mesh.t.shape[1]
+    write_msh(tmp_path / "block.msh", mesh, ["bottom", "top"])
+    scene = scene_dict({"dim": 3, "mesh": {"domain": "file", "file": str(tmp_path / "block.msh"),
+                                           "refine": 1},
+                        "boundary": {"dirichlet": ["top"], "contact": ["bottom"]},
+                        "contact.normal": {"law": "compliance", "c": 1e3}})
+    with caplog.at_level(logging.DEBUG, logger="skfem"):   # what it would print
+        problem = build_problem(scene_from_dict(scene))
+        assert problem.mesh.p.shape[1] > 1000 and problem.smallness is not None
+    said = [r.getMessage() for r in caplog.records if r.name.startswith("skfem")
+            and r.levelno >= logging.WARNING]
+    assert said == []
 
 
 def test_check_refuses_a_bad_scene_with_one_line(tmp_path):
@@ -39,8 +83,10 @@ def test_check_refuses_a_bad_scene_with_one_line(tmp_path):
 
 
 def test_quiet_solve_prints_no_warning_but_keeps_them(tmp_path):
-    # the debonding scene warns (its smallness condition fails)
-    path = ROOT / "studies/scenes/debonding.toml"
+    # a contact stiffness 1e12 times the body's warns
+    path = tmp_path / "stiff.toml"
+    path.write_text(to_toml(scene_dict({"contact.normal": {"law": "compliance", "c": 1e12},
+                                        "time.steps": 2})))
     out = tmp_path / "out"
     loud = CliRunner().invoke(main, ["solve", str(path), "--out", str(tmp_path / "loud")])
     quiet = CliRunner().invoke(main, ["solve", str(path), "--out", str(out), "--quiet"])

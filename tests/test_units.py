@@ -155,7 +155,8 @@ def test_without_units_the_axes_keep_the_scene_wording(glued):
 def test_beta_curves_have_no_end_lines_and_the_mean_is_defined(glued):
     fig = visuals.figure_beta(glued["with"])
     steps = [a for a in fig.axes[0].get_children() if isinstance(a, StepPatch)]
-    assert len(steps) == np.union1d([0], visuals.common.sample_levels(2)).size   # level 0, samples
+    drawn = np.union1d([0], visuals.levels.plot_levels(glued["with"]))   # level 0 and "auto"
+    assert len(steps) == drawn.size
     assert all(step.get_data().baseline is None for step in steps)
     legend = [t.get_text() for t in fig.axes[3].get_legend().get_texts()]
     assert legend[0] == "mean over Γ_C (weighted by facet length)"

@@ -272,7 +272,6 @@ def describe_motions(free, points):
     centre = points.mean(axis=1)
     scale = max(np.abs(points - centre[:, None]).max(), 1e-300)
     t, w = free[:d], free[d:] / scale   # u(x) = t + W (x − centre), W of w
-    nrot = w.shape[0]
     only_translations = _null_space(w, free.shape[1])   # (k, kt)
     translations = _orthonormal(t @ only_translations)
     words = [f"translation along {_direction(e)}" for e in translations.T]

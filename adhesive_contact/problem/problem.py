@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..fem.assembly import Assembly, LoadMap
+from ..fem.p1 import gradients
 from .smallness import smallness
 from .warnings import problem_warnings
 
@@ -41,6 +42,7 @@ class Problem:
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
     held_by_contact: tuple = ()  # the rigid motions only the contact terms hold, in words
     _smallness: dict = field(default=None, repr=False)
+    _geometry: tuple = field(default=None, repr=False)
 
     @property
     def smallness(self):
@@ -50,6 +52,15 @@ class Problem:
             self._smallness = smallness(self.scene, self.normal_law, self.friction,
                                         self.held_by_contact)
         return self._smallness
+
+    @property
+    def geometry(self):
+        """(grad λ (ncells, d+1, d), volume (ncells,)): the barycentric
+        gradients and measures of the cells, computed on first use and kept
+        (:func:`~adhesive_contact.fem.p1.gradients`)."""
+        if self._geometry is None:
+            self._geometry = gradients(self.mesh)
+        return self._geometry
 
     def warnings(self):
         """What the theory does not cover for this scene, and magnitudes it

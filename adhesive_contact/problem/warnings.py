@@ -1,20 +1,35 @@
 """Every warning about a valid scene or a finished run, one line each.
 
 Nothing here raises (refusals are :mod:`.checks`). Before a run,
-:func:`problem_warnings` says what the theory does not cover for the scene
-(the smallness condition of the error estimate, docs/model.md §3), a step
-beyond the explicit Euler bound of the bonding law, and a contact stiffness
-many orders of magnitude away from the body's (the step matrix is then
-ill-conditioned, or the contact law irrelevant); ``adhcontact solve``,
-``check`` and ``sweep`` show them. After a run, :func:`solution_warnings`
-says what the result shows: displacements that are not small against the
-body (the model is linear, small strain).
+:func:`problem_warnings` says what the scene's numbers make likely to go
+wrong: a step beyond the explicit Euler bound of the bonding law, and a
+contact stiffness many orders of magnitude away from the body's (the step
+matrix is then ill-conditioned, or the contact law irrelevant), and the
+material data the discretisation or physics cannot bear (:mod:`.plausibility`:
+ν near ½ with P1 elements, a modulus no solid has in the named units);
+``adhcontact solve``, ``check`` and ``sweep`` show them. The theory's
+smallness conditions (docs/model.md §3) are no warning: they are
+sufficient conditions that realistic adhesive scenes miss by orders of
+magnitude, so they are recorded (``summary.json``, ``adhcontact check``)
+and a run warns only when it shows a reason itself. After a run,
+:func:`solution_warnings` says what the result shows: steps whose energy
+is not locally strictly convex at the solution found, steps where two
+starts reached two solutions, and strains or rotations beyond what the
+linear, small-strain model represents.
 """
 
 import numpy as np
 
-#: the largest displacement allowed, as a fraction of the body's size
-DISPLACEMENT_FRACTION = 0.1
+from .plausibility import plausibility_warnings
+
+#: the largest principal strain |ε| the small-strain model is taken to represent
+STRAIN_LIMIT = 0.1
+#: the largest gap between the linear strain ε(u) and the Green–Lagrange strain
+#: ε(u) + ½ ∇uᵀ∇u (its quadratic part; 1 − cos θ for a rotation by θ: 18°)
+GREEN_LAGRANGE_GAP = 0.05
+#: the share of the body's volume beyond either limit that makes a warning
+#: (a single cell at a singular corner or a debonding front makes none)
+VOLUME_SHARE = 0.01
 #: the orders of magnitude between the contact stiffness and the body's
 STIFFNESS_ORDERS = 6
 
@@ -25,32 +40,132 @@ def body_size(problem):
     return float(np.linalg.norm(p.max(axis=1) - p.min(axis=1)))
 
 
-def largest_displacement(solution):
-    """max over levels and nodes of |u| (read one level at a time)."""
-    return max((float(np.linalg.norm(solution.u[n], axis=1).max())
-                for n in range(solution.t.size)), default=0.0)
+def gradient_measures(problem, u):
+    """Per cell of the P1 displacement ``u`` (npoints, d): the largest
+    principal strain |ε|, the rotation angle θ = asin(min(|ω|, 1)) of the
+    skew part ω of ∇u (|ω| its axial vector's length), and the largest
+    eigenvalue of the quadratic part ½ ∇uᵀ∇u of the Green–Lagrange strain.
+    Returns three (ncells,) arrays.
+
+    The eigenvalues are computed only in the cells whose Frobenius bounds
+    (|ε| ≤ ‖ε‖_F, λ_max(½ GᵀG) ≤ ½ ‖G‖_F²) exceed STRAIN_LIMIT or
+    GREEN_LAGRANGE_GAP; elsewhere the bound is returned, below the limit
+    (a run inside them costs two norms per cell and level)."""
+    grad_lambda, _ = problem.geometry
+    G = np.einsum("iea,eib->eab", u[problem.mesh.t], grad_lambda)   # ∂u_a/∂x_b
+    eps = 0.5 * (G + G.transpose(0, 2, 1))
+    omega = 0.5 * (G - G.transpose(0, 2, 1))
+    rotation = np.arcsin(np.minimum(np.sqrt(0.5 * (omega ** 2).sum(axis=(1, 2))), 1.0))
+    strain = np.sqrt((eps ** 2).sum(axis=(1, 2)))
+    quadratic = 0.5 * (G ** 2).sum(axis=(1, 2))
+    near = strain > STRAIN_LIMIT
+    strain[near] = np.abs(np.linalg.eigvalsh(eps[near])).max(axis=1)
+    near = quadratic > GREEN_LAGRANGE_GAP
+    Gn = G[near]
+    quadratic[near] = np.linalg.eigvalsh(0.5 * np.einsum("eca,ecb->eab", Gn, Gn)).max(axis=1)
+    return strain, rotation, quadratic
 
 
-def smallness_warning(problem):
-    """A line when the smallness condition of the error estimate fails."""
-    s = problem.smallness
-    if s is None or s["holds"]:
+#: the most levels the geometry is checked at (evenly spread, the last included)
+GEOMETRY_LEVELS = 64
+
+
+def geometry_warning(solution):
+    """A line when, at some level, more than VOLUME_SHARE of the body has
+    strains above STRAIN_LIMIT or a linear strain that misses the
+    Green–Lagrange strain by more than GREEN_LAGRANGE_GAP (rotations above
+    about 18°): what the small-strain model cannot represent."""
+    problem = solution.problem
+    _, volume = problem.geometry
+    total = volume.sum()
+    worst = None
+    count = solution.t.size
+    levels = np.unique(np.round(np.linspace(0, count - 1, min(count, GEOMETRY_LEVELS))))
+    for n in levels.astype(int):   # one level at a time (a streamed u is on disk)
+        strain, rotation, quadratic = gradient_measures(problem, np.asarray(solution.u[n]))
+        beyond = (strain > STRAIN_LIMIT) | (quadratic > GREEN_LAGRANGE_GAP)
+        share = volume[beyond].sum() / total
+        if share > VOLUME_SHARE and (worst is None or share > worst[0]):
+            worst = (share, n, strain, rotation, quadratic)
+    if worst is None:
         return None
-    if s.get("held_by_contact"):
-        return (f"only the contact terms hold the body against "
-                f"{', '.join(s['held_by_contact'])}: the smallness conditions (which need "
-                f"the held sides to stop every rigid motion) do not apply, and a load those "
-                f"terms cannot balance has no equilibrium "
-                f"(docs/model.md#a-body-held-by-contact)")
-    tail = ("each step still has one solution (its energy is convex)"
-            if s["step_energy_convex"] else
-            "a step may have several solutions and the solver may pick any or fail")
-    return (f"the smallness condition of the error estimate does not hold "
-            f"(m_A = {s['m_A']:.4g} against (m_tau + m_nu) c_e^2 = {s['rhs']:.4g}): "
-            f"the theory does not promise a unique solution or first-order "
-            f"convergence here, and {tail}; softer contact laws or a stiffer "
-            f"body move the scene inside it "
-            f"(docs/model.md#the-three-smallness-conditions)")
+    share, n, strain, rotation, quadratic = worst
+    cell = int(np.argmax(np.maximum(strain / STRAIN_LIMIT, quadratic / GREEN_LAGRANGE_GAP)))
+    centre = problem.mesh.p[:, problem.mesh.t[:, cell]].mean(axis=1)
+    point = "(" + ", ".join(f"{c:.3g}" for c in centre) + ")"
+    reasons, cannot = [], []
+    if strain.max() > STRAIN_LIMIT:
+        reasons.append(f"strains up to {strain.max():.3g} (more than {STRAIN_LIMIT:g})")
+        cannot.append("large strains")
+    if quadratic.max() > GREEN_LAGRANGE_GAP:
+        reasons.append(f"rotations up to {np.degrees(rotation.max()):.0f}°, where the linear "
+                       f"strain misses the Green–Lagrange strain by up to "
+                       f"{quadratic.max():.3g} (more than {GREEN_LAGRANGE_GAP:g})")
+        cannot.insert(0, "finite rotations (a rotated part stretches instead: a lifted arm "
+                         "is drawn stretched straight up)")
+    return (f"at t = {solution.t[n]:.4g}, {100 * share:.0f}% of the body is beyond the "
+            f"small-strain model, with {' and '.join(reasons)}, worst near {point}: the "
+            f"model is linear in the displacement and cannot represent "
+            f"{' nor '.join(cannot)}; the result is outside its range "
+            "(docs/conventions.md#the-model-is-small-strain)")
+
+
+def step_list(steps, times, most=8):
+    """"steps 3–5, 9 (t = 0.3–0.5, 0.9)" for the sorted step numbers ``steps``."""
+    runs = []
+    for n in steps:
+        if runs and n == runs[-1][1] + 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    shown = runs[:most]
+    numbers = ", ".join(str(a) if a == b else f"{a}–{b}" for a, b in shown)
+    at = ", ".join(f"{times[a]:.4g}" if a == b else f"{times[a]:.4g}–{times[b]:.4g}"
+                   for a, b in shown)
+    more = f" and {len(runs) - most} more ranges" if len(runs) > most else ""
+    return f"step{'s' if len(steps) > 1 else ''} {numbers}{more} (t = {at})"
+
+
+def nonconvex_step_warning(solution):
+    """A line naming the steps whose Newton matrix at the solution was
+    indefinite and had to be modified (the step energy is not locally
+    strictly convex there: the solution found may be a saddle, or one of
+    several)."""
+    steps = tuple(getattr(solution, "indefinite_steps", ()))
+    if not steps:
+        return None
+    return (f"the step energy is not locally strictly convex at the solution of "
+            f"{step_list(steps, solution.t)}: its Newton matrix there was indefinite and "
+            "had to be modified, so the solution found may be one of several; softer "
+            "contact laws (a smaller friction nonconvexity) or a stiffer body make the "
+            "step convex (docs/model.md#the-three-smallness-conditions)")
+
+
+def two_solutions_warning(solution):
+    """A line naming the steps where a second start (z = 0) reached another
+    converged solution than the start from the previous level."""
+    found = dict(getattr(solution, "two_solution_steps", {}))
+    if not found:
+        return None
+    steps = sorted(found)
+    return (f"{step_list(steps, solution.t)} {'have' if len(steps) > 1 else 'has'} "
+            f"more than one solution: a second start "
+            f"from Γ_C at rest reached another one (differing by up to "
+            f"{100 * max(found.values()):.2g}% of the largest contact displacement); "
+            "the run follows the one continued from the previous level (the quasistatic "
+            "path) (docs/model.md#the-three-smallness-conditions)")
+
+
+def held_by_contact_warning(problem):
+    """A line when only the contact terms hold the body against some rigid
+    motion (``problem.held_by_contact``)."""
+    motions = getattr(problem, "held_by_contact", ())
+    if not motions:
+        return None
+    return (f"only the contact terms hold the body against {', '.join(motions)}: the "
+            f"smallness conditions (which need the held sides to stop every rigid motion) "
+            f"do not apply, and a load those terms cannot balance has no equilibrium "
+            f"(docs/model.md#a-body-held-by-contact)")
 
 
 def explicit_bound_warning(problem):
@@ -85,23 +200,14 @@ def stiffness_warning(problem):
                if ratio > 1 else "(the foundation barely holds the body)"))
 
 
-def displacement_warning(solution):
-    """A line when max |u| exceeds DISPLACEMENT_FRACTION of the body's size."""
-    size = body_size(solution.problem)
-    largest = largest_displacement(solution)
-    if largest <= DISPLACEMENT_FRACTION * size:
-        return None
-    return (f"the largest displacement {largest:.3g} is {100 * largest / size:.0f}% of the "
-            f"body's size {size:.3g} (more than {100 * DISPLACEMENT_FRACTION:.0f}%): the "
-            "model assumes small strains; the result is outside its range")
-
-
 def problem_warnings(problem):
     """The lines of the checks of a scene that apply, before a run."""
-    return [w for w in (smallness_warning(problem), explicit_bound_warning(problem),
-                        stiffness_warning(problem)) if w is not None]
+    return [w for w in (held_by_contact_warning(problem), explicit_bound_warning(problem),
+                        stiffness_warning(problem))
+            if w is not None] + plausibility_warnings(problem.scene)
 
 
 def solution_warnings(solution):
     """The lines of the checks of a finished run that apply."""
-    return [w for w in (displacement_warning(solution),) if w is not None]
+    return [w for w in (nonconvex_step_warning(solution), two_solutions_warning(solution),
+                        geometry_warning(solution)) if w is not None]

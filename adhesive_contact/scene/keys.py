@@ -234,6 +234,8 @@ _DECLARATIONS = (
         "kink, relative to the body's diameter", bounds="positive"),
 
     Key("output.probes", "list", (), "the points whose displacement is recorded"),
+    Key("output.plot_times", "list", "auto", "the times the figures draw: a list of times "
+        "in [0, T], or \"auto\" (where the run's activity is, and T)"),
     Key("output.units", "table", None, "the names of the units the scene's numbers are in "
         "(none when absent)"),
     Key("output.units.length", "str", None, "the unit of length, on the plots' axes"),

@@ -49,13 +49,14 @@ def scene_from_dict(data, base_dir=None):
     contact = read_contact(top.table("contact"), dim, contact_sides)
     T, steps = read_time(top.table("time"))
     solver = read_solver(top.table("solver"))
-    probes, units = read_output(top.table("output"), dim)
+    probes, units, plot_times = read_output(top.table("output"), dim, T)
     exact = read_exact(top.table("exact"), dim, contact, top.has("loads"))
     top.finish()
     if memory is not None and memory.kernel == "relaxation":
         check_relaxation_step(memory, dim, T / steps)
     scene = Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
-                  traction, contact, T, steps, solver, probes, exact, displacement, units)
+                  traction, contact, T, steps, solver, probes, exact, displacement, units,
+                  plot_times)
     check_something_holds(scene, by_file)
     return scene
 

@@ -30,7 +30,9 @@ def resolved(scene):
         "time": {"T": scene.T, "steps": scene.steps, "k": scene.k},
         "solver": _solver_record(scene.solver),
         "output": {"probes": [list(p) for p in scene.probes],
-                   **({"units": dict(scene.units)} if scene.units else {})},
+                   **({"units": dict(scene.units)} if scene.units else {}),
+                   **({"plot_times": list(scene.plot_times)}
+                      if scene.plot_times != "auto" else {})},
         "exact": _exact_record(scene.exact),
     }
 

@@ -201,6 +201,7 @@ class Scene:
     exact: ExactSpec = None       # None: no manufactured solution
     displacement: dict = field(default_factory=dict)  # side -> d Expressions or None ("free")
     units: dict = field(default_factory=dict)  # quantity -> unit name ([output] units)
+    plot_times: object = "auto"   # the figures' times: "auto" or a sorted tuple
 
     @property
     def held_sides(self):

@@ -231,12 +231,35 @@ def read_solver(table):
     return SolverSpec(method, tol, max_iter, linear, penalty, smoothing, linear_tol)
 
 
-def read_output(table, dim):
-    """(probes, units) of the [output] table: none of either without it."""
+#: the most times ``output.plot_times`` may list (a figure stays readable)
+MAX_PLOT_TIMES = 12
+
+
+def read_output(table, dim, T):
+    """(probes, units, plot times) of the [output] table: none of the first
+    two and "auto" without it."""
     if table is None:
-        return (), {}
+        return (), {}, "auto"
     units = _read_units(table.table("units"))
-    return _read_probes(table, dim), units
+    times = _read_plot_times(table, T)
+    return _read_probes(table, dim), units, times
+
+
+def _read_plot_times(table, T):
+    """``output.plot_times``: "auto", or a sorted tuple of distinct times in [0, T]."""
+    table.used.add("plot_times")
+    raw = table.data.get("plot_times", "auto")
+    if raw == "auto":
+        return "auto"
+    key = table.key("plot_times")
+    if not (isinstance(raw, list) and 1 <= len(raw) <= MAX_PLOT_TIMES and all(
+            isinstance(t, (int, float)) and not isinstance(t, bool) for t in raw)):
+        raise SceneError(key, f"must be \"auto\" or a list of 1 to {MAX_PLOT_TIMES} times "
+                         f"(numbers), got {show(raw)}")
+    for t in raw:
+        if not 0.0 <= t <= T:
+            raise SceneError(key, f"every time must lie in [0, T] = [0, {T:g}], got {t:g}")
+    return tuple(sorted({float(t) for t in raw}))
 
 
 def _read_units(table):

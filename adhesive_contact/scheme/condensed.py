@@ -47,7 +47,12 @@ def dense_solver(H, mixed_from=MIXED_FROM):
     From ``mixed_from`` rows on, the Cholesky factor is computed in single
     precision (about 1.8 times faster here, the whole cost of a Newton
     iteration at thousands of contact unknowns) and the solution refined to
-    double precision by :func:`mixed_precision_solver`."""
+    double precision by :func:`mixed_precision_solver`.
+
+    The returned solve has the attribute ``indefinite``: True when H has an
+    eigenvalue below −INDEFINITE times its largest, so that the
+    factorisation had to modify it (the step energy is not locally
+    strictly convex where H was taken)."""
     if H.shape[0] >= mixed_from:
         solve = mixed_precision_solver(H.astype(np.float32), lambda v: H @ v,
                                        np.abs(np.diag(H)).max(), lambda: H)
@@ -58,11 +63,24 @@ def dense_solver(H, mixed_from=MIXED_FROM):
         # Fortran order, which LAPACK takes without the transposing copy
         # f2py makes of a C-ordered array (a 6000² Cholesky: 0.72 → 0.42 s)
         factor = la.cho_factor(H.T, check_finite=False)
-        return lambda rhs: la.cho_solve(factor, rhs, check_finite=False)
+        return flagged(lambda rhs: la.cho_solve(factor, rhs, check_finite=False), False)
     except la.LinAlgError:
         vals, vecs = la.eigh(H)
-        vals = np.maximum(np.abs(vals), 1e-8 * max(np.abs(vals).max(), 1e-300))
-        return lambda rhs: vecs @ ((vecs.T @ rhs) / vals)
+        largest = max(np.abs(vals).max(initial=0.0), 1e-300)
+        indefinite = bool(vals.min(initial=0.0) < -INDEFINITE * largest)
+        vals = np.maximum(np.abs(vals), 1e-8 * largest)
+        return flagged(lambda rhs: vecs @ ((vecs.T @ rhs) / vals), indefinite)
+
+
+#: an eigenvalue below −INDEFINITE·(the largest) makes a Newton matrix
+#: indefinite (above it, a Cholesky that failed met round-off only)
+INDEFINITE = 1e-10
+
+
+def flagged(solve, indefinite):
+    """``solve`` with the attribute ``indefinite`` (see :func:`dense_solver`)."""
+    solve.indefinite = indefinite
+    return solve
 
 
 def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
@@ -103,7 +121,7 @@ def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
         if info == 0:
             return x
         return dense_solver(exact(), mixed_from=np.inf)(rhs)
-    return solve
+    return flagged(solve, False)   # single precision factorised it: not indefinite
 
 
 class RememberedProduct:
@@ -135,6 +153,10 @@ def restricted(H, free):
 
 class DenseSchur(RememberedProduct):
     """S formed: a dense symmetric (nC, nC) matrix."""
+
+    #: whether the Newton matrix of the last :meth:`newton_solve` was
+    #: indefinite (:func:`dense_solver`), and how many were so far
+    indefinite, indefinite_solves = False, 0
 
     def __init__(self, S):
         self.matrix = S
@@ -177,8 +199,12 @@ class DenseSchur(RememberedProduct):
             largest = np.abs(self.matrix[idx, idx] + H_FF.diagonal()).max()
             solve = mixed_precision_solver(H32, apply, largest, exact)
             if solve is not None:
+                self.indefinite = False
                 return solve(rhs), True
-        return dense_solver(exact(), mixed_from=np.inf)(rhs), True
+        solve = dense_solver(exact(), mixed_from=np.inf)
+        self.indefinite = solve.indefinite
+        self.indefinite_solves += solve.indefinite
+        return solve(rhs), True
 
 
 class ImplicitSchur:
@@ -197,6 +223,7 @@ class ImplicitSchur:
         self.approximation = approximation
         self.shape = approximation.shape
         self.tol, self.max_iter = tol, max_iter
+        self.indefinite, self.indefinite_solves = False, 0   # as in DenseSchur
 
     def __matmul__(self, z):
         return self.A_CC @ z - self.A_CI @ self.solver.solve(self.A_IC @ z)
@@ -213,6 +240,8 @@ class ImplicitSchur:
         H_FF = restricted(H_phi, free).tocsr()
         precondition = dense_solver(self.approximation.take(idx, 0).take(idx, 1)
                                     + H_FF.toarray())
+        self.indefinite = precondition.indefinite   # of the nearby matrix
+        self.indefinite_solves += precondition.indefinite
         full = np.zeros(self.shape[0])
 
         def apply(v):

@@ -39,13 +39,15 @@ import scipy.sparse as sp
 from .condensed import RememberedProduct
 
 
-def truncated_cg(apply, precondition, rhs, rtol, atol, maxiter, restarts=3):
+def truncated_cg(apply, precondition, rhs, rtol, atol, maxiter, restarts=3,
+                 on_negative_curvature=None):
     """Preconditioned CG for K x = rhs from x = 0, until the true residual
     ‖rhs − K x‖₂ ≤ max(rtol ‖rhs‖₂, atol) (restarted on it, up to
     ``restarts`` times, when the recurrence's residual has drifted from
     it), or to the first p with pᵀ K p ≤ 0 (K indefinite): ``(x,
     converged, iterations)``, x then the last iterate (the preconditioned
-    residual if there is none yet), along which ½ xᵀ K x − rhsᵀ x decreases."""
+    residual if there is none yet), along which ½ xᵀ K x − rhsᵀ x decreases;
+    ``on_negative_curvature()`` is then called, if given."""
     x = np.zeros_like(rhs)
     bound = max(rtol * np.linalg.norm(rhs), atol)
     r = rhs.copy()
@@ -60,6 +62,8 @@ def truncated_cg(apply, precondition, rhs, rtol, atol, maxiter, restarts=3):
             curvature = p @ q
             iterations += 1
             if not curvature > 0:
+                if on_negative_curvature is not None:
+                    on_negative_curvature()
                 return (x if iterations > 1 or restart else z), False, iterations
             alpha = rz / curvature
             x += alpha * p
@@ -89,6 +93,8 @@ class FullSystemMatrix(RememberedProduct):
         self.maxiter = maxiter
         self._diagonal = self.A.diagonal()
         self.iterations = 0         # CG iterations of all Newton systems so far
+        self.indefinite = False     # CG of the last Newton system met pᵀ K p ≤ 0
+        self.indefinite_solves = 0  # and how many did so far
 
     @property
     def matrix(self):
@@ -118,9 +124,16 @@ class FullSystemMatrix(RememberedProduct):
         full[free] = rhs
         # K v = a_n v + (K − a_n) v, with this operator's a_n (A at t = 0, whose
         # preconditioner is the hierarchy of A + k R(0))
+        self.indefinite = False
+
+        def negative():
+            self.indefinite = True
+            self.indefinite_solves += 1
+
         d, converged, iterations = truncated_cg(lambda v: self.A @ v + shift @ v,
                                                 lambda r: precondition @ r,
-                                                full, rtol, atol, self.maxiter)
+                                                full, rtol, atol, self.maxiter,
+                                                on_negative_curvature=negative)
         self.iterations += iterations
         return d[free], converged
 

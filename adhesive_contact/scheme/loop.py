@@ -65,9 +65,14 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
                "total": problem.assembly_seconds + (t_end - t0)}
     message = {SUCCESS: "all steps converged", STEP_FAILED: str(failure),
                STOPPED: f"stopped after step {state.n} (t = {state.t:g})"}[status]
+    done = recorder.count
+    notes = {} if contact is None else {
+        "indefinite_steps": tuple(n for n in sorted(contact.indefinite_steps) if n < done),
+        "two_solution_steps": {n: r for n, r in sorted(contact.two_solution_steps.items())
+                               if n < done}}
     return Solution(problem=problem, status=status, message=message, failure=failure,
-                    t=problem.times[:recorder.count].copy(), timings=timings,
-                    linear=operators.linear, **recorder.history())
+                    t=problem.times[:done].copy(), timings=timings,
+                    linear=operators.linear, **notes, **recorder.history())
 
 
 def march(problem, operators, contact, recorder, state, progress=None):

@@ -66,6 +66,11 @@ class Solution:
                                   # (problem.prescribed.fixed); see adhesive_contact.postprocess.reactions
     timings: dict = field(default_factory=dict)
     linear: dict = field(default_factory=dict)   # the linear backend and why: {"method", "reason"}
+    # the steps n whose Newton matrix at the solution was indefinite (the step
+    # energy not locally strictly convex there), and those of them where a
+    # second start from z = 0 reached another solution: n -> |Δz|_∞/|z|_∞
+    indefinite_steps: tuple = ()
+    two_solution_steps: dict = field(default_factory=dict)
 
     @property
     def success(self):

@@ -56,6 +56,9 @@ class Level:
 
 
 NEWTON = ("newton", "newton-plain")   # the methods that converge quadratically
+#: two solutions of a step differ when |Δz|_∞ exceeds this fraction of |z|_∞
+#: (each is converged to solver.tol on the forces, 1e-10 by default)
+SECOND_START_RTOL = 1e-6
 
 
 class ContactStep:
@@ -83,6 +86,9 @@ class ContactStep:
         self.kink = None
         self.kink_nodes = np.zeros(0, dtype=np.int64)
         self.seconds = 0.0   # spent in the step method, over all levels so far
+        # the steps whose Newton matrix at the solution was indefinite, and
+        # those of them where a second start reached another solution
+        self.indefinite_steps, self.two_solution_steps = set(), {}
         if problem.friction is not None:
             # every friction law gets its slip directions held (κ_a = 0 without a
             # kink): Newton on φ' = μ|ξ|^q, not Lipschitz at 0, would flip ξ.
@@ -125,7 +131,14 @@ class ContactStep:
         start = time.perf_counter()
         if before is not None and solver.method == "newton":
             z0 = self.predictor(S, c, upper, z0, before, n)
+        S.indefinite, solves_before = False, S.indefinite_solves
         result = minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
+        result.indefinite = bool(S.indefinite and result.nit > 0)
+        if result.success:
+            if result.indefinite:
+                self.indefinite_steps.add(n)
+            if S.indefinite_solves > solves_before:   # a nonconvex energy on the way
+                self.second_start(S, c, upper, options, n, z0, result)
         self.seconds += time.perf_counter() - start
         return result
 
@@ -150,6 +163,23 @@ class ContactStep:
         def energy(z):
             return 0.5 * z @ (S @ z) - c @ z + self.energy.value(z)
         return guess if energy(guess) < energy(start) else start
+    def second_start(self, S, c, upper, options, n, z0, result):
+        """Solve step n again from z = 0 (Γ_C at rest) when its iterations
+        from ``z0`` met an indefinite Newton matrix (a nonconvex energy), and note
+        the step (``result.another_start``, :attr:`two_solution_steps`: n ->
+        |Δz|_∞ / |z|_∞) when the two converged solutions differ by more than
+        SECOND_START_RTOL of the larger. The run goes on with ``result``."""
+        if not np.any(z0):
+            return
+        other = minimise(self.problem.scene.solver.method, S, c, self.energy, upper,
+                         np.zeros_like(z0), options, self.kink)
+        if not other.success:
+            return
+        size = max(np.abs(result.z).max(initial=0.0), np.abs(other.z).max(initial=0.0))
+        gap = float(np.abs(result.z - other.z).max(initial=0.0))
+        if gap > SECOND_START_RTOL * size:
+            result.another_start = True
+            self.two_solution_steps[n] = float(gap / size)
 
     def options(self, S):
         """The StepOptions of a step with matrix S: the scene's tolerances and,

@@ -40,7 +40,13 @@ class StepResult:
     ``inner_failures`` the Newton systems whose iterative solve (CG, for an
     applied Schur complement) stopped before its tolerance;
     ``wall_violation`` max (z_ν − g)_+ the method left (0 for the exact
-    methods, which project onto the wall)."""
+    methods, which project onto the wall); ``indefinite`` whether the
+    Newton matrix S + ∂²Φ of the last iteration was indefinite and its
+    factorisation modified (the step energy not locally strictly convex at
+    the solution), set by the caller from the operator's flag
+    (:class:`~adhesive_contact.scheme.condensed.DenseSchur`);
+    ``another_start`` whether a second start reached another solution
+    (:class:`~adhesive_contact.scheme.state.ContactStep`)."""
 
     z: np.ndarray
     status: int
@@ -54,6 +60,8 @@ class StepResult:
     on_wall: np.ndarray = field(default=None, repr=False)     # bool per unknown
     stuck: np.ndarray = field(default=None, repr=False)       # bool per node with a kink (ξ_a = 0)
     wall_violation: float = 0.0
+    indefinite: bool = False
+    another_start: bool = False
 
     @property
     def success(self):

@@ -82,13 +82,15 @@ def scene_source(scene):
 
 def scene_identity(scene):
     """What a scene contributes to a study's identity: its resolved record
-    without ``solver.linear`` and ``output.units``. The linear backend
-    changes how the linear systems are solved, not the discrete solution
-    (every backend solves to round-off or its tolerance), and the units
-    name the plots' axes only, so a study may resume with other ones."""
+    without ``solver.linear``, ``output.units`` and ``output.plot_times``.
+    The linear backend changes how the linear systems are solved, not the
+    discrete solution (every backend solves to round-off or its
+    tolerance), and the units and plot times change the plots only, so a
+    study may resume with other ones."""
     resolved = dict(scene.resolved)
     resolved["solver"] = {k: v for k, v in resolved["solver"].items() if k != "linear"}
-    resolved["output"] = {k: v for k, v in resolved["output"].items() if k != "units"}
+    resolved["output"] = {k: v for k, v in resolved["output"].items()
+                          if k not in ("units", "plot_times")}
     return resolved
 
 

@@ -41,6 +41,7 @@ from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.quantities import beta_mean
 from ..postprocess.scalars import scalar_quantities
 from ..postprocess.states import contact_state_counts
+from ..problem.warnings import solution_warnings
 from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 
@@ -215,7 +216,9 @@ def run_variant(document, values):
     nodes of u_ν − g (None without a wall); ``quantities`` the scalars of
     :func:`~adhesive_contact.postprocess.scalar_quantities` (the peak and
     final reaction of each held side, the energies and the debonded area at
-    T). A failed run has None for what needs the solution.
+    T); ``warnings`` what the solution shows
+    (:func:`~adhesive_contact.problem.warnings.solution_warnings`).
+    A failed run has None for what needs the solution.
     """
     t0 = time.perf_counter()
     problem = build_problem(scene_from_dict(variant_document(document, values)))
@@ -241,7 +244,8 @@ def run_variant(document, values):
         **{f"{key}_T": states.get(key) for key in ("separated", "on_wall", "compliance",
                                                   "stick", "slip")},
         "normal_force_T": solution.total_normal_force()[-1],
-        "quantities": scalar_quantities(solution)})
+        "quantities": scalar_quantities(solution),
+        "warnings": solution_warnings(solution)})
 
 
 def _setup(document, runs):

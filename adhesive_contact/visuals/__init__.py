@@ -7,7 +7,8 @@ One module per figure of a run: :mod:`.deformed` (``deformed.png``),
 :mod:`.debonding` (``debonding.png``), and :func:`write_plots` (:mod:`.solution`)
 drawing those a solution has into a folder; :mod:`.studies` draws the
 figures of a convergence study and of a sweep; :mod:`.common` holds what
-they share (:class:`Units`, titles, :func:`save_figure`).
+they share (:class:`Units`, titles, :func:`save_figure`) and :mod:`.levels`
+which time levels, axis along Γ_C and colour scales a run's figures draw.
 
 Each ``figure_*`` function returns a :class:`matplotlib.figure.Figure`
 (made with :mod:`matplotlib.pyplot`), each ``plot_*`` function saves it
@@ -28,6 +29,7 @@ from .contact_map import figure_contact_map, plot_contact_map
 from .debonding import figure_debonding, plot_debonding
 from .deformed import figure_deformed, magnification, plot_deformed
 from .energy import figure_energy, plot_energy
+from .levels import contact_axis, plot_levels
 from .load import figure_load_displacement, load_curves, plot_load_displacement
 from .solution import PLOT_NAMES, write_plots
 from .studies import (
@@ -49,4 +51,5 @@ __all__ = ["DPI", "Units", "plot_title", "save_figure", "figure_deformed", "plot
            "load_curves", "figure_energy", "plot_energy", "figure_debonding",
            "plot_debonding", "PLOT_NAMES", "write_plots", "figure_error_vs_size",
            "plot_error_vs_size", "figure_work_precision", "plot_work_precision",
-           "write_convergence_plots", "figure_by_key", "plot_by_key", "write_sweep_plots"]
+           "write_convergence_plots", "figure_by_key", "plot_by_key", "write_sweep_plots",
+           "contact_axis", "plot_levels"]

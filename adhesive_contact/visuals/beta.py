@@ -5,15 +5,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..postprocess import beta_mean
-from .common import (
-    AXES,
-    Units,
-    along_axis,
-    facet_midpoints,
-    sample_levels,
-    save_figure,
-    solution_title,
-)
+from .common import AXES, Units, facet_midpoints, save_figure, solution_title
+from .levels import automatic, contact_axis, plot_levels
 
 
 def _time_edges(t):
@@ -37,7 +30,7 @@ def beta_space_time(problem, beta, length="units of length"):
     names the unit of length in the label."""
     boundary = problem.boundary
     mid = facet_midpoints(problem)
-    axis = along_axis(mid)
+    axis = contact_axis(problem)
     name = AXES[axis]
     ends = problem.mesh.p[axis][boundary.facet_nodes]     # (d, nf)
     if problem.dim == 2:
@@ -73,8 +66,9 @@ def mean_label(dim):
 def figure_beta(solution):
     """β along Γ_C: curves at a few levels, a space-time image, mean and min in time.
 
-    Left column (sharing the coordinate along Γ_C): β per facet at a few
-    levels, and below it β(x, t) as an image (x horizontally, t vertically,
+    Left column (sharing the coordinate along Γ_C, the axis along which it
+    extends most, :func:`~.levels.contact_axis`): β per facet at the levels
+    of :func:`~.levels.plot_levels` (and t = 0 with "auto"), and below it β(x, t) as an image (x horizontally, t vertically,
     colour β in [0, 1]) with the β = 1/2 contour when debonding reaches it.
     Right column: the facet-measure weighted mean, the min and the max of β
     in time.
@@ -91,10 +85,12 @@ def figure_beta(solution):
     problem = solution.problem
     units = Units.of(solution)
     mid = facet_midpoints(problem)
-    axis = along_axis(mid)
+    axis = contact_axis(problem)
     order = np.argsort(mid[axis], kind="stable")
     x = mid[axis, order]
-    levels = np.unique(np.concatenate([[0], sample_levels(solution.steps)]))
+    levels = plot_levels(solution)
+    if automatic(solution):   # β_0 too: what the glue starts from
+        levels = np.unique(np.concatenate([[0], levels]))
     colours = plt.cm.viridis(np.linspace(0.0, 0.9, levels.size))
     fig = plt.figure(figsize=(12.5, 8.5))
     # columns: curves / image, colorbar, a spacer for its labels, history

@@ -1,5 +1,6 @@
 """What the figures share: the units on their axes, their titles, saving a
-PNG atomically, tidy 3D axes, the sampled time levels and where Γ_C lies.
+PNG atomically, tidy 3D axes and where Γ_C lies (the levels and colour
+scales a figure draws are :mod:`.levels`).
 
 Nothing here chooses a matplotlib backend: the figures are drawn with
 whichever the caller's process uses (a notebook keeps its own; the
@@ -119,12 +120,6 @@ def save_figure(fig, path, bbox_inches="tight"):
         plt.close(fig)
 
 
-def sample_levels(steps, count=5):
-    """About ``count`` time levels spread over 1..N, always including N."""
-    levels = np.round(np.linspace(steps / count, steps, count)).astype(int)
-    return np.unique(np.clip(levels, 0, steps))
-
-
 def tangent_direction(problem):
     """The common tangent τ of the contact nodes, or None if the frames differ.
 
@@ -137,14 +132,6 @@ def tangent_direction(problem):
     if not np.allclose(tau, tau[0], atol=1e-9):
         return None
     return tau[0]
-
-
-def along_axis(points):
-    """The coordinate axis (0, 1, 2) along which points (d, n) spread most."""
-    points = np.asarray(points)
-    if points.shape[1] == 0:
-        return 0
-    return int(np.argmax(points.max(axis=1) - points.min(axis=1)))
 
 
 def facet_midpoints(problem):

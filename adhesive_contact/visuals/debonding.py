@@ -5,7 +5,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..postprocess import debond_fronts, debonded_area, energies, energy_per_area
-from .common import AXES, Units, along_axis, save_figure, solution_title
+from .common import AXES, Units, save_figure, solution_title
+from .levels import contact_axis
 from .energy import energy_label
 
 
@@ -30,7 +31,7 @@ def figure_debonding(solution, history=None):
     units = Units.of(solution)
     t = solution.t
     fig, (ax, bx, cx) = plt.subplots(1, 3, figsize=(13, 4))
-    axis = along_axis(problem.boundary.points)
+    axis = contact_axis(problem)
     fronts = debond_fronts(solution)
     times = np.concatenate([np.full(len(f), tn) for f, tn in zip(fronts, t)])
     where = np.concatenate([f[:, axis] for f in fronts]) if times.size else np.zeros(0)

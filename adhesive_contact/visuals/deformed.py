@@ -36,6 +36,7 @@ def _deformed_2d(fig, ax, solution, factor, units):
     vm = cell_von_mises(solution, -1)
     tri = Triangulation(p[0], p[1], mesh.t.T)
     image = ax.tripcolor(tri, facecolors=vm, cmap="viridis", shading="flat")
+    image.set_clim(*stress_limits(vm))
     ax.triplot(tri, color="k", linewidth=0.2, alpha=0.4)
     outline = mesh.p[:, mesh.facets[:, mesh.boundary_facets()]].transpose(2, 1, 0)
     ax.add_collection(LineCollection(outline, colors="0.4", linestyles="--", linewidths=0.8,
@@ -50,8 +51,10 @@ def _deformed_2d(fig, ax, solution, factor, units):
     ax.set_ylabel(f"y ({units.length})")
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")
     # below the axes: a colorbar as wide as a flat domain, never taller than it
-    fig.colorbar(image, ax=ax, location="bottom", shrink=0.7, pad=0.14, aspect=35,
-                 label=f"{VON_MISES} (plane strain: σ_zz included; {units.stress})")
+    bar = fig.colorbar(image, ax=ax, location="bottom", shrink=0.7, aspect=35,
+                       label=f"{VON_MISES} (plane strain: σ_zz included; {units.stress})")
+    bar.formatter.set_useOffset(False)
+    bar.update_ticks()
 
 
 def _deformed_3d(fig, solution, factor, units):
@@ -62,7 +65,7 @@ def _deformed_3d(fig, solution, factor, units):
     p = mesh.p + factor * solution.u[-1].T
     faces = mesh.boundary_facets()
     vm = cell_von_mises(solution, -1)[mesh.f2t[0, faces]]
-    norm = plt.Normalize(vm.min(), vm.max())
+    norm = plt.Normalize(*stress_limits(vm))
     polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
     ax.add_collection3d(Poly3DCollection(polys, facecolors=plt.cm.viridis(norm(vm)),
                                          edgecolors="k", linewidths=0.1))
@@ -71,9 +74,18 @@ def _deformed_3d(fig, solution, factor, units):
     tidy_3d_axes(ax)
     ax.set_box_aspect(high - low)
     mappable = plt.cm.ScalarMappable(norm=norm, cmap="viridis")
-    fig.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12,
-                 label=f"{VON_MISES} ({units.stress})")
+    bar = fig.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12,
+                       label=f"{VON_MISES} ({units.stress})")
+    bar.formatter.set_useOffset(False)
+    bar.update_ticks()
     return ax
+
+
+def stress_limits(vm):
+    """The colour scale of the von Mises stress: from 0 to its largest, a
+    scale of 1 when it is zero (no offset text over a nearly constant field)."""
+    top = float(np.max(vm, initial=0.0))
+    return 0.0, (top if top > 0 else 1.0)
 
 
 def figure_deformed(solution):
@@ -95,7 +107,7 @@ def figure_deformed(solution):
     mesh = solution.problem.mesh
     units = Units.of(solution)
     factor = magnification(mesh.p, solution.u[-1])
-    fig = plt.figure(figsize=(9, 5))
+    fig = plt.figure(figsize=(9, 5), layout="constrained")
     if mesh.dim() == 2:
         ax = fig.add_subplot()
         _deformed_2d(fig, ax, solution, factor, units)

@@ -295,12 +295,32 @@ def figure_by_key(rows, keys, key, title, units=None, dim=2):
         ax.set_xlabel(key)
     handles = axes[0, 0].get_legend_handles_labels()[0]
     if any(label for label in groups) and handles:
-        fig.legend(handles, list(groups), loc="outside lower center", fontsize="small",
-                   title="other settings", ncols=min(3, len(groups)))
+        fit_legend(fig, handles, list(groups), title="other settings")
     failed = sum(row["outcome"] != "ok" for row in rows)
     note = f"; × on the time panel: {failed} failed run(s)" if failed else ""
     fig.suptitle(f"{plot_title(title)}\nsweep over {key}{note}", fontsize="medium")
     return fig
+
+
+#: the longest line of a legend entry (longer ones are wrapped)
+LEGEND_LINE = 60
+
+
+def fit_legend(fig, handles, labels, title=None):
+    """A legend below the panels of a constrained-layout figure that fits
+    inside it: long labels wrapped at LEGEND_LINE characters, and as many
+    columns (at most 3) as leave it no wider than the figure."""
+    import textwrap
+
+    labels = ["\n".join(textwrap.wrap(label, LEGEND_LINE)) or label for label in labels]
+    renderer = fig.canvas.get_renderer()
+    for ncols in range(min(3, len(labels)), 0, -1):
+        legend = fig.legend(handles, labels, loc="outside lower center", fontsize="small",
+                            title=title, ncols=ncols)
+        if ncols == 1 or legend.get_window_extent(renderer).width <= 0.98 * fig.bbox.width:
+            return legend
+        legend.remove()
+    return legend
 
 
 def plot_by_key(path, rows, keys, key, title, units=None, dim=2):

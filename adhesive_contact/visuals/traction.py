@@ -5,15 +5,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..postprocess import contact_states, normal_traction, tangential_traction
-from .common import (
-    AXES,
-    Units,
-    along_axis,
-    sample_levels,
-    save_figure,
-    solution_title,
-    tangent_direction,
-)
+from .common import AXES, Units, save_figure, solution_title, tangent_direction
+from .levels import contact_axis, floored, plot_levels, run_scale
 
 
 def _tangent_label(problem):
@@ -31,8 +24,9 @@ def _tangent_label(problem):
 def figure_contact_traction(solution):
     """Normal and tangential traction and the normal displacement along Γ_C.
 
-    Three panels sharing the coordinate along Γ_C, one curve per sampled
-    time level: the normal traction −σ_ν (compression > 0), the tangential
+    Three panels sharing the coordinate along Γ_C (the axis along which it
+    extends most, :func:`~.levels.contact_axis`), one curve per level of
+    :func:`~.levels.plot_levels`: the normal traction −σ_ν (compression > 0), the tangential
     traction σ_τ (2D: its component along the nodal tangent; 3D: |σ_τ|),
     both the nodal force of Γ_C on the body over the lumped nodal weight,
     and u_ν with the gap. Nodes on the wall are ringed; with a friction kink
@@ -51,12 +45,15 @@ def figure_contact_traction(solution):
     units = Units.of(solution)
     boundary = problem.boundary
     x_nodes = problem.mesh.p[:, boundary.nodes]
-    axis = along_axis(x_nodes)
+    axis = contact_axis(problem)
     order = np.argsort(x_nodes[axis], kind="stable")
     x = x_nodes[axis, order]
     normal = normal_traction(solution)[:, order]
     shear = tangential_traction(solution)[:, order]
     shear = shear[:, :, 0] if problem.dim == 2 else np.linalg.norm(shear, axis=2)
+    # round-off drawn as zero, on the scale of the run's largest traction
+    scale = max(run_scale(normal), run_scale(shear))
+    normal, shear = floored(normal, scale), floored(shear, scale)
     un = solution.normal_displacement[:, order]
     wall = solution.on_wall[:, order]
     states = contact_states(solution)
@@ -65,9 +62,10 @@ def figure_contact_traction(solution):
     gap = None if problem.gap is None else problem.gap[:, order]
     style = "-" if problem.dim == 2 else "none"  # 3D: scattered nodes, no lines
 
-    levels = sample_levels(solution.steps)
+    levels = plot_levels(solution)
     colours = plt.cm.viridis(np.linspace(0.0, 0.9, levels.size))
-    fig, (top, middle, bottom) = plt.subplots(3, 1, sharex=True, figsize=(8.5, 9.5))
+    fig, (top, middle, bottom) = plt.subplots(3, 1, sharex=True, figsize=(10, 9.5),
+                                              layout="constrained")
     for n, colour in zip(levels, colours):
         top.plot(x, normal[n], linestyle=style, marker=".", color=colour,
                  label=f"t = {solution.t[n]:.4g}")
@@ -84,6 +82,7 @@ def figure_contact_traction(solution):
     for ax in (top, middle, bottom):
         ax.axhline(0.0, color="0.6", linewidth=0.8)
         ax.grid(True, color="0.9", linewidth=0.6)
+        ax.ticklabel_format(axis="y", useOffset=False)
     top.set_ylabel(f"normal traction −σ_ν\n(> 0 compression, < 0 tension;\n{units.stress})")
     what = "contact traction and gap" if gap is not None else "contact traction"
     top.set_title(f"{solution_title(solution)}\n{what} along Γ_C", fontsize="medium")
@@ -115,7 +114,7 @@ def figure_contact_traction(solution):
 
 def plot_contact_traction(solution, path):
     """``contact_traction.png``: :func:`figure_contact_traction` saved into ``path``."""
-    save_figure(figure_contact_traction(solution), path)
+    save_figure(figure_contact_traction(solution), path, bbox_inches=None)
 
 
 def _clip_gap_axis(ax, un, gap):

@@ -11,6 +11,8 @@ the coarse facet it refines. New vertices are midpoints of straight coarse
 edges: a curved side of a file mesh is not re-projected onto the curve.
 """
 
+from dataclasses import replace
+
 import numpy as np
 
 
@@ -78,12 +80,25 @@ def with_boundaries(mesh, boundaries):
     return named
 
 
+def unnamed(mesh):
+    """``mesh`` without its named boundaries, the facets it built kept:
+    what is refined, since scikit-fem drops the names there and says so on
+    stderr (they are carried by :func:`refined_with_boundaries`)."""
+    if not mesh.boundaries:
+        return mesh
+    bare = replace(mesh, _boundaries=None)
+    for name in ENTITIES:
+        if name in vars(mesh) and name not in vars(bare):
+            setattr(bare, name, getattr(mesh, name))
+    return bare
+
+
 def refined_with_boundaries(mesh, times):
     """``mesh`` refined uniformly ``times`` times, its named boundaries
     carried to the fine facets that refine theirs."""
     names = dict(mesh.boundaries or {})
     for _ in range(times):
-        fine = mesh.refined(1)
+        fine = unnamed(mesh).refined(1)
         if names:
             boundary = fine.boundary_facets()
             parents = refinement_parents(mesh, fine, boundary)

@@ -128,7 +128,9 @@ def read_mesh_file(path, dim):
     used = np.unique(t)
     renumber = np.full(p.shape[1], -1)
     renumber[used] = np.arange(used.size)
-    mesh = (MeshTri if dim == 2 else MeshTet)(p[:, used], renumber[t])
+    # C-ordered arrays: scikit-fem copies others and says so on stderr
+    mesh = (MeshTri if dim == 2 else MeshTet)(np.ascontiguousarray(p[:, used]),
+                                              np.ascontiguousarray(renumber[t]))
     boundaries = {}
     for group, nodes in groups.items():
         index = facet_index(mesh, renumber[nodes]) if nodes.size else np.zeros(0, int)
