@@ -142,8 +142,27 @@ def test_a_nearly_constant_stress_draws_no_offset_text():
     bar = fig.axes[-1]
     vm = visuals.deformed.cell_von_mises(sol, -1)
     assert np.ptp(vm) <= 1e-9 * vm.max()
-    assert bar.get_ylim() == pytest.approx((0.0, vm.max()), rel=1e-12)
-    assert bar.yaxis.get_offset_text().get_text() == ""
+    # the load grows with t: the largest stress over the levels drawn is that at T
+    assert bar.get_xlim() == pytest.approx((0.0, vm.max()), rel=1e-12)
+    assert bar.xaxis.get_offset_text().get_text() == ""
+    plt.close("all")
+
+
+def test_the_3d_deformed_view_is_drawn_at_the_plot_levels_on_one_scale(box):
+    """One panel per plot level (at most 4, T last), titled by its time; one
+    colour bar from 0 to the largest von Mises stress over those levels."""
+    fig = visuals.figure_deformed(box)
+    levels = visuals.plot_levels(box)
+    levels = levels[np.unique(np.round(np.linspace(0, levels.size - 1, 4)).astype(int))] \
+        if levels.size > 4 else levels
+    panels = [ax for ax in fig.axes if ax.get_title().startswith("t = ")]
+    assert len(panels) == len(levels) > 1
+    assert [float(ax.get_title()[4:]) for ax in panels] == pytest.approx(box.t[levels], rel=1e-3)
+    bar = [ax for ax in fig.axes if ax not in panels][0]
+    mesh = box.problem.mesh
+    owner = mesh.f2t[0, mesh.boundary_facets()]
+    largest = max(visuals.deformed.cell_von_mises(box, n)[owner].max() for n in levels)
+    assert bar.get_xlim() == pytest.approx((0.0, largest), rel=1e-12)
     plt.close("all")
 
 
@@ -200,4 +219,23 @@ def test_every_legend_lies_inside_its_figure(box, window):
             assert inside(fig, legend), (fig.axes[0].get_title(), legend.get_title().get_text())
             count += 1
     assert count >= 7
+    plt.close("all")
+
+
+def test_a_run_that_kept_only_the_last_stress_is_drawn_by_displacement(box):
+    """A streamed run keeps σ at T only: every panel is then coloured by |u|,
+    on one scale from 0 to the largest |u| at a face over the levels drawn."""
+    from dataclasses import replace
+
+    streamed = replace(box, stress=box.stress[-1:])
+    fig = visuals.figure_deformed(streamed)
+    panels = [ax for ax in fig.axes if ax.get_title().startswith("t = ")]
+    (bar,) = [ax for ax in fig.axes if ax not in panels]
+    assert bar.get_xlabel().startswith("|u| (units of length")
+    levels = np.array([int(np.argmin(np.abs(box.t - float(ax.get_title()[4:]))))
+                       for ax in panels])
+    mesh = box.problem.mesh
+    nodes = mesh.facets[:, mesh.boundary_facets()]
+    largest = max(np.linalg.norm(box.u[n], axis=1)[nodes].mean(axis=0).max() for n in levels)
+    assert bar.get_xlim() == pytest.approx((0.0, largest), rel=1e-12)
     plt.close("all")

@@ -1,5 +1,5 @@
-"""``deformed.png``: the deformed mesh at the final time, coloured by the von
-Mises stress."""
+"""``deformed.png``: the deformed mesh coloured by the von Mises stress, at
+the final time in 2D and at the run's plot levels in 3D."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -8,6 +8,10 @@ from matplotlib.tri import Triangulation
 
 from ..postprocess import cell_von_mises
 from .common import Units, save_figure, solution_title, tidy_3d_axes
+from .levels import floored, plot_levels, run_scale, thinned
+
+#: the most levels (panels) the 3D view draws
+DEFORMED_LEVELS = 4
 
 #: the von Mises stress of the colour bars: of the whole 3 × 3 stress
 VON_MISES = "von Mises stress"
@@ -57,28 +61,52 @@ def _deformed_2d(fig, ax, solution, factor, units):
     bar.update_ticks()
 
 
+def _face_values(solution, n, faces, stressed):
+    """The colour of each boundary face at level n: the von Mises stress of
+    its cell where the level's stress is kept, else |u| at its nodes."""
+    mesh = solution.problem.mesh
+    if stressed:
+        return cell_von_mises(solution, n)[mesh.f2t[0, faces]]
+    u = np.linalg.norm(np.asarray(solution.u[n]), axis=1)
+    return u[mesh.facets[:, faces]].mean(axis=0)
+
+
 def _deformed_3d(fig, solution, factor, units):
+    """One panel per level of :func:`~.levels.plot_levels` (at most
+    DEFORMED_LEVELS, T last), one colour scale over them, floored at the
+    run's largest value (round-off drawn as zero)."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     mesh = solution.problem.mesh
-    ax = fig.add_subplot(projection="3d")
-    p = mesh.p + factor * solution.u[-1].T
+    levels = thinned(plot_levels(solution), DEFORMED_LEVELS)
+    # a streamed run keeps the stress of its last level only: then |u| at every level
+    stressed = solution.stress is not None and np.shape(solution.stress)[0] == solution.t.size
     faces = mesh.boundary_facets()
-    vm = cell_von_mises(solution, -1)[mesh.f2t[0, faces]]
-    norm = plt.Normalize(*stress_limits(vm))
-    polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
-    ax.add_collection3d(Poly3DCollection(polys, facecolors=plt.cm.viridis(norm(vm)),
-                                         edgecolors="k", linewidths=0.1))
-    low, high = p.min(axis=1), p.max(axis=1)
-    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
-    tidy_3d_axes(ax)
-    ax.set_box_aspect(high - low)
+    values = [_face_values(solution, n, faces, stressed) for n in levels]
+    top = run_scale(np.concatenate(values))
+    norm = plt.Normalize(*stress_limits(np.array([top])))
+    axes = []
+    for i, (n, value) in enumerate(zip(levels, values)):
+        ax = fig.add_subplot(1, levels.size, i + 1, projection="3d")
+        p = mesh.p + factor * np.asarray(solution.u[n]).T
+        polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
+        colours = plt.cm.viridis(norm(floored(value, top)))
+        ax.add_collection3d(Poly3DCollection(polys, facecolors=colours, edgecolors="k",
+                                             linewidths=0.1))
+        low, high = p.min(axis=1), p.max(axis=1)
+        ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+        tidy_3d_axes(ax)
+        ax.set_box_aspect(high - low)
+        ax.set_title(f"t = {solution.t[n]:.4g}", fontsize="small")
+        axes.append(ax)
     mappable = plt.cm.ScalarMappable(norm=norm, cmap="viridis")
-    bar = fig.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12,
-                       label=f"{VON_MISES} ({units.stress})")
+    label = (f"{VON_MISES} ({units.stress})" if stressed else
+             f"|u| ({units.length}; the stress of a streamed run is kept at T only)")
+    bar = fig.colorbar(mappable, ax=axes, shrink=0.7, pad=0.08, location="bottom",
+                       label=label)
     bar.formatter.set_useOffset(False)
     bar.update_ticks()
-    return ax
+    return axes
 
 
 def stress_limits(vm):
@@ -94,7 +122,10 @@ def figure_deformed(solution):
 
     2D: the cells at x + f u(T), the reference outline dashed and the
     contact nodes on the wall as red dots; 3D: the boundary faces of the
-    deformed body. The factor f is :func:`magnification` (1: to scale).
+    deformed body at the levels of :func:`~.levels.plot_levels` (at most
+    DEFORMED_LEVELS, one colour scale; |u| where a streamed run kept no
+    stress). The factor f is :func:`magnification` (1: to scale), of the
+    largest displacement over the levels drawn.
 
     Parameters
     ----------
@@ -106,18 +137,26 @@ def figure_deformed(solution):
     """
     mesh = solution.problem.mesh
     units = Units.of(solution)
-    factor = magnification(mesh.p, solution.u[-1])
-    fig = plt.figure(figsize=(9, 5), layout="constrained")
+    scale_text = "displacements to scale"
     if mesh.dim() == 2:
+        factor = magnification(mesh.p, solution.u[-1])
+        fig = plt.figure(figsize=(9, 5), layout="constrained")
         ax = fig.add_subplot()
         _deformed_2d(fig, ax, solution, factor, units)
-    else:
-        ax = _deformed_3d(fig, solution, factor, units)
-    scale = ("displacements to scale" if factor == 1.0 else
-             f"displacements magnified ×{factor:g}")
-    coordinates = f"; x, y, z in {units.length}" if mesh.dim() == 3 else ""
-    ax.set_title(f"{solution_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, "
-                 f"{scale}{coordinates}", fontsize="medium")
+        if factor != 1.0:
+            scale_text = f"displacements magnified ×{factor:g}"
+        ax.set_title(f"{solution_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, "
+                     f"{scale_text}", fontsize="medium")
+        return fig
+    levels = thinned(plot_levels(solution), DEFORMED_LEVELS)
+    largest = max(levels, key=lambda n: float(np.abs(np.asarray(solution.u[n])).max()))
+    factor = magnification(mesh.p, np.asarray(solution.u[largest]))
+    if factor != 1.0:
+        scale_text = f"displacements magnified ×{factor:g}"
+    fig = plt.figure(figsize=(4.5 * levels.size + 1.0, 5.5), layout="constrained")
+    _deformed_3d(fig, solution, factor, units)
+    fig.suptitle(f"{solution_title(solution)}\ndeformed mesh, {scale_text}; x, y, z in "
+                 f"{units.length}", fontsize="medium")
     return fig
 
 
