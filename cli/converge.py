@@ -79,11 +79,29 @@ def table(document):
     fit = document["rates"]
     size = "k" if document["param"] == "k" else "h"
     n = len(document["levels"])
+    lines += quantity_table(document)
     lines.append(f"least-squares rates over {n} levels (slope of log error against log "
                  f"{size}): u {_fmt(fit['u'], '.3f')}, β {_fmt(fit['beta'], '.3f')}, "
                  f"E {_fmt(fit['E'], '.3f')}"
+                 + (f", Q {_fmt(fit['Q'], '.3f')}" if "Q" in fit else "")
                  + (f"  (only {n} levels: a meaningful rate needs >= {MEANINGFUL_LEVELS})"
                     if n < MEANINGFUL_LEVELS else ""))
+    return lines
+
+
+def quantity_table(document):
+    """The lines of a study of a quantity (none without one): per level Q_h,
+    |Q_h − Q_ref|, that relative to |Q_ref| and the pairwise rate."""
+    if "quantity" not in document:
+        return []
+    q = document["quantity"]
+    lines = [f"quantity {q['name']}: Q_ref = {_fmt(q['reference'], '.6g')} (the fine "
+             "reference run's value)",
+             f"{'level':>5} {'Q_h':>13} {'|Q_h−Q_ref|':>12} {'rel':>7} {'rate':>6}"]
+    for row in document["levels"]:
+        lines.append(f"{row['level']:>5} {_fmt(row['quantity'], '.6g'):>13} "
+                     f"{_fmt(row['err_q'], '.3e'):>12} {_fmt(row['rel_q'], '.1e'):>7} "
+                     f"{_fmt(row['rate_q'], '.2f'):>6}")
     return lines
 
 
@@ -124,11 +142,15 @@ def option_name(key):
                    "for an h-study, so that the time error stays below the space error).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path),
               help="Output folder. Default: ./<scene file stem>-converge-<param>.")
+@click.option("--quantity", default=None, metavar="NAME",
+              help="Also fit the rate of this scalar quantity's error |Q_h − Q_ref| "
+                   "against the fine reference (e.g. reaction_top_y_peak, debonding_T; "
+                   "the names of a sweep's runs.csv, docs/outputs.md).")
 @click.option("--force", is_flag=True,
               help="Run even when the largest run's estimated memory or time exceeds what "
                    "the machine has.")
 def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, base_refine,
-             base_steps, out, force):
+             base_steps, out, quantity, force):
     """Convergence study of SCENE (a TOML file) in h, k or both (docs/verification.md).
 
     Prints a table of the errors ‖ε(u − u_h)‖, ‖β − β_h‖ and E (max over the
@@ -139,8 +161,12 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     The study resumes: the folder keeps study.json, each finished level
     (levels/level_NN.json) and the fine reference (reference.npz), and the
     same command run again computes only what is missing. Any other study
-    (another scene, --param, --levels, --reference, --ref-h or --ref-k;
-    more --levels too) is refused in that folder: use another --out.
+    (another scene, --param, --levels, --reference, --ref-h, --ref-k or
+    --quantity; more --levels too) is refused in that folder: use another --out.
+
+    With --quantity NAME the table also has the quantity Q_h per level, its
+    error against the fine reference's value and their rates, and
+    quantity_vs_h.png (or _vs_k) is drawn.
     """
     name, text = read_scene(scene)
     _, problem = load_scene(text, scene_folder(scene), force)
@@ -149,7 +175,7 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
     study = open_study(lambda: ConvergenceStudy(
         study_source(text, scene_folder(scene)), param, levels, reference, folder=out,
         ref_h=ref_h, ref_k=ref_k, refine=base_refine, steps=base_steps,
-        scene_file=str(scene)), out, "study", option_name)
+        scene_file=str(scene), quantity=quantity), out, "study", option_name)
     guard(study.reference_scene or level_scene(study.scene, param, levels - 1), force,
           what="the largest run of the study")
     executor = open_executor(scheduler, jobs)

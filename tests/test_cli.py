@@ -603,7 +603,10 @@ def test_glued_plots_are_written(glued):
 
 BAD_LAWS = [
     # (id, changes to GLUED_SCENE, what the message must contain)
-    ("coulomb", {"contact.friction": law("coulomb", mu=1.0)}, "contact.friction.law"),
+    ("amontons", {"contact.friction": law("amontons", mu=1.0)}, "contact.friction.law"),
+    ("coulomb without a normal compliance",
+     {"contact.friction": law("coulomb", mu=1.0), "contact.normal": law("none")},
+     "law 'coulomb' has the bound μ p_ν"),
     ("nonmonotone a <= b", {"contact.friction": law("nonmonotone", a=1.0, b=2.0, alpha=5.0)},
      "contact.friction.a"),
     ("nonmonotone a = b in a list",

@@ -98,9 +98,9 @@ def counting(monkeypatch):
     calls = SimpleNamespace(levels=[], reference=0)
     real_level, real_reference = converge_module.run_level, converge_module.run_reference
 
-    def run_level(scene, param, level, reference=None):
+    def run_level(scene, param, level, reference=None, **kwargs):
         calls.levels.append(level)
-        return real_level(scene, param, level, reference)
+        return real_level(scene, param, level, reference, **kwargs)
 
     def run_reference(*args, **kwargs):
         calls.reference += 1
@@ -285,11 +285,11 @@ def test_interrupted_study_computes_only_the_missing_levels(fine_study, tmp_path
     out = tmp_path / "out"
     counted = converge_module.run_level
 
-    def fail_on_level_2(scene, param, level, reference=None):
+    def fail_on_level_2(scene, param, level, reference=None, **kwargs):
         if level == 2:
             raise StepFailure(3, 0.375, SimpleNamespace(message="simulated failure",
                                                         residual=1.0, tolerance=1e-10, nit=50))
-        return counted(scene, param, level, reference)
+        return counted(scene, param, level, reference, **kwargs)
 
     monkeypatch.setattr(converge_module, "run_level", fail_on_level_2)
     result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)

@@ -165,9 +165,9 @@ def test_convergence_study_from_python(tmp_path, monkeypatch, capsys):
     calls = []
     real = convergence_study.run_level
 
-    def counted(scene, param, level, reference=None):
+    def counted(scene, param, level, reference=None, **kwargs):
         calls.append(level)
-        return real(scene, param, level, reference)
+        return real(scene, param, level, reference, **kwargs)
 
     monkeypatch.setattr(convergence_study, "run_level", counted)
     scene = tmp_path / "exact.toml"

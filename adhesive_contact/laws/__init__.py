@@ -33,11 +33,13 @@ class in its module and one entry here.
 """
 
 from .bonding import Fremond, truncate
-from .friction import AdhesiveSpring, FrictionSum, PowerLaw, SlipWeakening, Tresca
+from .friction import (AdhesiveSpring, Coulomb, FrictionSum, PointBound, PowerLaw,
+                       SlipWeakening, Tresca)
 from .normal import AdhesiveCompliance, NoNormalLaw, NormalCompliance, separation
 
 __all__ = ["NORMAL_LAWS", "FRICTION_LAWS", "BONDING_LAWS", "make_normal_law", "make_friction",
-           "make_bonding", "Fremond", "AdhesiveSpring", "FrictionSum", "PowerLaw",
+           "make_bonding", "Fremond", "AdhesiveSpring", "Coulomb", "FrictionSum", "PointBound",
+           "PowerLaw",
            "SlipWeakening", "Tresca", "AdhesiveCompliance", "NoNormalLaw", "NormalCompliance",
            "separation", "truncate"]
 
@@ -51,6 +53,7 @@ NORMAL_LAWS = {
 FRICTION_LAWS = {
     "none": (None, {}),
     "tresca": (Tresca, {"mu": "positive"}),
+    "coulomb": (Coulomb, {"mu": "positive"}),
     "nonmonotone": (SlipWeakening, {"a": "positive", "b": "positive", "alpha": "positive"}),
     "power": (PowerLaw, {"mu": "positive", "q": "positive"}),
     "adhesive_spring": (AdhesiveSpring, {"gamma": "positive", "L": "positive"}),

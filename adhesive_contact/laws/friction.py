@@ -1,6 +1,10 @@
 """Friction potentials j_τ(β, ξ) = φ(β, |ξ|) of docs/model.md §4: Tresca,
 slip weakening (nonmonotone), power law, adhesive spring, and their sum
-(the interface of :mod:`adhesive_contact.laws`)."""
+(the interface of :mod:`adhesive_contact.laws`); and a Coulomb-type bound
+μ p_ν(β, u_ν)_+ (:class:`Coulomb`), which depends on u_ν and is outside
+the paper's theory (docs/model.md, "Coulomb-type friction"): a step
+freezes it at a normal pressure (:meth:`FrictionSum.with_pressure`) and
+iterates on that pressure (:mod:`adhesive_contact.scheme.state`)."""
 
 from dataclasses import dataclass
 
@@ -24,6 +28,60 @@ class Tresca:
 
     def dphi(self, beta, s):
         return np.full(np.shape(s), float(self.mu))
+
+    def ddphi(self, beta, s):
+        return np.zeros_like(s)
+
+
+@dataclass(frozen=True)
+class Coulomb:
+    """A Coulomb-type bound: j_τ = μ (p_ν)_+ |ξ|, p_ν = p_ν(β, u_ν) the normal
+    law's reaction at the same point (docs/model.md, "Coulomb-type friction").
+
+    Not a potential of (β, ξ) alone: it is used frozen at a pressure,
+    :meth:`at_pressure`, a :class:`PointBound` κ_q = μ (p_q)_+ per point.
+    Calling its φ, φ', φ'' or kink unfrozen is an error. Where the surface
+    has separated (p_ν ≤ 0: no compression, or the glue pulling) the bound
+    is 0. m_τ and c_1 are those of the frozen law (0, bounded); the
+    dependence of the bound on u_ν is what the paper's theorem does not cover.
+    """
+
+    mu: float
+    has_kink = True
+    pressure_dependent = True
+    m_tau = 0.0
+    c_1 = 0.0
+
+    def at_pressure(self, pressure):
+        """The law frozen at the normal pressure p_q (nq,) of each point."""
+        return PointBound(self.mu * np.maximum(np.asarray(pressure, dtype=float), 0.0))
+
+    def _unfrozen(self, *args):
+        raise ValueError("the Coulomb bound μ p_ν depends on u_ν: freeze it at a normal "
+                         "pressure first (FrictionSum.with_pressure)")
+
+    kink = phi = dphi = ddphi = _unfrozen
+
+
+@dataclass(frozen=True, eq=False)
+class PointBound:
+    """j_τ = κ_q |ξ| with a given bound κ_q ≥ 0 per quadrature point: Tresca
+    with a bound that varies along Γ_C (a frozen :class:`Coulomb`). Its
+    arrays have the shape of ``bound`` (nq,): the contact points."""
+
+    bound: np.ndarray
+    has_kink = True
+    m_tau = 0.0
+    c_1 = 0.0
+
+    def kink(self, beta):
+        return np.broadcast_to(self.bound, np.shape(beta)).copy()
+
+    def phi(self, beta, s):
+        return self.bound * s
+
+    def dphi(self, beta, s):
+        return np.broadcast_to(self.bound, np.shape(s)).copy()
 
     def ddphi(self, beta, s):
         return np.zeros_like(s)
@@ -141,6 +199,18 @@ class FrictionSum:
     """A sum of friction potentials: φ = Σ_i φ_i, kink = Σ_i kink_i."""
 
     laws: tuple
+
+    @property
+    def pressure_dependent(self):
+        """Whether a law's bound depends on the normal pressure (:class:`Coulomb`)."""
+        return any(getattr(law, "pressure_dependent", False) for law in self.laws)
+
+    def with_pressure(self, pressure):
+        """The sum with every pressure-dependent law frozen at ``pressure``
+        (nq,), p_ν(β_q, u_ν,q) at the contact points."""
+        return FrictionSum(tuple(law.at_pressure(pressure)
+                                 if getattr(law, "pressure_dependent", False) else law
+                                 for law in self.laws))
 
     @property
     def m_tau(self):

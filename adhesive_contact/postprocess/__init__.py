@@ -13,7 +13,7 @@ from .quantities import (FRAMES, beta_mean, cell_von_mises, contact_fields,
                          von_mises)
 from .reactions import (applied_traction, prescribed_history, reaction_sides, reactions,
                         side_mean_displacement, side_reactions)
-from .scalars import scalar_quantities
+from .scalars import quantity_names, scalar_quantities
 from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STATE_TOLERANCE, STICK, WALL,
                      contact_measure, contact_state_code, contact_state_codes,
                      contact_state_counts, contact_states, state_masks, state_tolerance)
@@ -24,7 +24,8 @@ __all__ = ["DISSIPATED", "STORED", "EnergyHistory", "energies", "energy_unavaila
            "contact_traction", "normal_traction", "penetration", "stress_3x3",
            "tangential_traction", "to_global", "total_contact_force", "von_mises",
            "applied_traction", "prescribed_history", "reaction_sides", "reactions",
-           "side_mean_displacement", "side_reactions", "scalar_quantities", "COMPLIANCE",
+           "side_mean_displacement", "side_reactions", "scalar_quantities", "quantity_names",
+           "COMPLIANCE",
            "SEPARATED", "SLIP", "STATE_NAMES", "STATE_TOLERANCE", "STICK", "WALL",
            "contact_measure", "contact_state_code", "contact_state_codes", "contact_state_counts",
            "contact_states", "state_masks", "state_tolerance"]

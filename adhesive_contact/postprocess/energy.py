@@ -100,6 +100,10 @@ def _negative_semidefinite(lam, mu, dim):
 def energy_unavailable(problem):
     """Why a run of ``problem`` has no energy balance (a sentence), or None."""
     memory = problem.scene.memory
+    if problem.friction is not None and problem.friction.pressure_dependent:
+        return ("a Coulomb-type friction bound mu p_nu(beta, u_nu) is no potential of the "
+                "displacement: the contact terms have no stored energy and the balance "
+                "does not hold (docs/model.md#coulomb-type-friction)")
     if problem.beta_source is not None:
         return ("a manufactured solution's bonding source makes β grow: the glue's "
                 "energy balance does not hold")

@@ -62,3 +62,9 @@ def scalar_quantities(solution):
     out.update(debonded_area_T=float(area[-1]), damage_T=float(damage[-1]),
                glue_energy_per_area_T=None if per is None or np.isnan(per) else float(per))
     return out
+
+
+def quantity_names(problem):
+    """Every name :func:`scalar_quantities` gives for a run of ``problem``, in
+    its order (a value may still be None: no energy balance, no facets)."""
+    return [*reaction_names(problem), *ENERGY_NAMES, *DEBONDING_NAMES]

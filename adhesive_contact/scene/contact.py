@@ -30,6 +30,11 @@ def read_contact(table, dim, contact_sides):
     friction = _read_friction(table)
     bonding, beta0, integrator = _read_bonding(table.table("bonding"), dim)
     table.finish()
+    if any(f.law == "coulomb" for f in friction) and normal.law not in ("compliance",
+                                                                        "adhesive_compliance"):
+        raise SceneError(table.key("friction"), "law 'coulomb' has the bound μ p_ν(β, u_ν) "
+                         "of the normal law: it needs [contact.normal] law 'compliance' or "
+                         f"'adhesive_compliance', got {normal.law!r}")
     kinked = [f.law for f in friction if FRICTION_LAWS[f.law][0].has_kink]
     if quadrature == "gauss" and kinked:
         smooth = ", ".join(name for name, (cls, _) in FRICTION_LAWS.items()

@@ -55,7 +55,10 @@ class ContactEnergy:
 
         self.N = trace(boundary.normal_trace)
         self.normal_law = normal_law
-        self.friction = friction
+        # the scene's friction; ``friction`` is it with a Coulomb bound frozen
+        # at the pressure of :meth:`set_pressure` (the same object without one)
+        self.friction_law = self.friction = friction
+        self.pressure_dependent = friction is not None and friction.pressure_dependent
         self.T = ([trace(t) for t in boundary.tangential_trace]
                   if friction is not None else [])
         self.nz = size
@@ -68,10 +71,23 @@ class ContactEnergy:
                        if friction is not None else [])
         self.n0 = self.t0 = None
         self.set_bonding(beta)
+        if self.pressure_dependent:
+            self.set_pressure(None)
 
     def set_bonding(self, beta):
         """Use β_n (nf,) per contact facet from now on."""
         self.beta = self.boundary.at_points(beta)
+
+    def set_pressure(self, z):
+        """Freeze a Coulomb bound μ p_ν(β_q, u_ν,q)_+ at the normal pressure
+        of ``z`` (at 0 for None) from now on (docs/model.md, "Coulomb-type
+        friction"); returns p_q (nq,). Nothing for other friction laws."""
+        if not self.pressure_dependent:
+            return None
+        pressure = (np.zeros(self.w.size) if z is None
+                    else self.normal_law.value(self.beta, self.normal(z)))
+        self.friction = self.friction_law.with_pressure(pressure)
+        return pressure
 
     def set_held(self, values):
         """Use the held values z_D from now on: ``values`` (nc·d,) the frame

@@ -119,9 +119,8 @@ class ContactStep:
         :meth:`predictor` where that lowers the step energy."""
         problem = self.problem
         self.energy.set_bonding(beta)
-        if self.kink is not None:
-            self.kink.radius = self.energy.node_kink(
-                problem.boundary.point_node, problem.boundary.nodes.size)[self.kink_nodes]
+        self.energy.set_pressure(z0)   # a Coulomb bound: at the last level's pressure first
+        self.set_radius()
         solver = problem.scene.solver
         options = self.options(S)
         if solver.method in NEWTON:
@@ -133,6 +132,8 @@ class ContactStep:
             z0 = self.predictor(S, c, upper, z0, before, n)
         S.indefinite, solves_before = False, S.indefinite_solves
         result = minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
+        if self.energy.pressure_dependent and result.success:
+            result = self.pressure_fixed_point(S, c, upper, options, result)
         result.indefinite = bool(S.indefinite and result.nit > 0)
         if result.success:
             if result.indefinite:
@@ -140,6 +141,44 @@ class ContactStep:
             if S.indefinite_solves > solves_before:   # a nonconvex energy on the way
                 self.second_start(S, c, upper, options, n, z0, result)
         self.seconds += time.perf_counter() - start
+        return result
+
+    def set_radius(self):
+        """κ_a of the kinks from the friction (frozen at its pressure)."""
+        if self.kink is not None:
+            boundary = self.problem.boundary
+            self.kink.radius = self.energy.node_kink(
+                boundary.point_node, boundary.nodes.size)[self.kink_nodes]
+
+    def pressure_fixed_point(self, S, c, upper, options, result):
+        """A Coulomb bound's fixed point within the step (docs/model.md,
+        "Coulomb-type friction"): with the bound frozen at the pressure
+        p_ν(β_n, u_ν) of the last solution, solve the step again (a Tresca
+        step, from that solution) until the nodal bounds κ_a change by at
+        most ``options.tol`` times their largest value; then the step's
+        residual with the bound at its own solution is below the tolerance
+        too. Not converging in ``max_iter`` passes is the step's failure
+        (MAX_ITERATIONS, with the change reached)."""
+        passes = max(int(self.problem.scene.solver.max_iter), 1)
+        nit = result.nit
+        for _ in range(passes):
+            before = self.kink.radius.copy()
+            self.energy.set_pressure(result.z)
+            self.set_radius()
+            change = float(np.abs(self.kink.radius - before).max(initial=0.0))
+            if change <= options.tol * max(self.kink.radius.max(initial=0.0), 1e-300):
+                result.nit = nit
+                return result
+            result = minimise(self.problem.scene.solver.method, S, c, self.energy, upper,
+                              result.z, options, self.kink)
+            nit += result.nit
+            if not result.success:
+                return result
+        result.status = MAX_ITERATIONS
+        result.message = (f"the Coulomb bound μ p_ν did not settle in {passes} fixed-point "
+                          f"passes on the normal pressure (its nodal bound still changed by "
+                          f"{change:.3g}); try smaller steps or a smaller mu")
+        result.nit = nit
         return result
 
     def predictor(self, S, c, upper, last, before, n):

@@ -13,6 +13,14 @@ study on top of :class:`~adhesive_contact.studies.study.Study`. Its folder:
 - ``errors.csv`` and ``rates.json`` (:func:`results`): rewritten from the
   saved records at the end of every completed run.
 
+A study of a scalar quantity (``quantity``, a name of
+:func:`~adhesive_contact.postprocess.scalars.quantity_names`, e.g. the
+peak reaction of a held side) also fits the rate of |Q_h − Q_ref| against
+the fine reference's Q. Every level record and the reference keep all
+the run's scalar quantities; the quantity studied is part of the study's
+identity (another quantity is another study, in another folder), and a
+saved level or reference without it is recomputed.
+
 From Python::
 
     from pathlib import Path
@@ -25,6 +33,7 @@ From Python::
 """
 
 import csv
+import json
 import math
 import zipfile
 from dataclasses import dataclass, replace
@@ -33,6 +42,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..postprocess.scalars import quantity_names, scalar_quantities
+from ..problem.build import build_problem
 from ..verification.rates import pairwise_rates, rates
 from ..verification.levels import (
     PARAMS,
@@ -58,6 +69,9 @@ RELATIVE_KEYS = ("rel_u", "rel_beta", "rel_E")
 RECORD_KEYS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "seconds")
 CSV_COLUMNS = ("level", "h", "k", "dofs", "steps", "err_u", "err_beta", "E", "rate_E",
                "seconds", *RELATIVE_KEYS)
+#: the columns a study of a quantity adds: Q_h, |Q_h − Q_ref|, that over
+#: |Q_ref|, and the pairwise rate of |Q_h − Q_ref|
+QUANTITY_COLUMNS = ("quantity", "err_q", "rel_q", "rate_q")
 #: docs/verification.md: a rate is fitted over at least 4 levels
 MEANINGFUL_LEVELS = 4
 #: the largest run a study may ask for (dofs); beyond it the set-up alone
@@ -75,12 +89,16 @@ def save_reference(path, reference):
               "refine": np.int64(reference.scene.mesh.refine),
               "steps": np.int64(reference.scene.steps),
               "seconds": np.float64(reference.seconds)}
+    if reference.quantities is not None:
+        arrays["quantities"] = np.array(json.dumps(reference.quantities))
     write_atomic(path, lambda f: np.savez_compressed(f, **arrays), binary=True)
 
 
-def load_reference(path, scene, arrays=True):
+def load_reference(path, scene, arrays=True, quantity=None):
     """The saved :class:`Reference` of reference scene ``scene``; None when
-    ``path`` is missing, unreadable or of another refine or number of steps.
+    ``path`` is missing, unreadable or of another refine or number of steps,
+    or, with a ``quantity`` name, when it has no value of that quantity (a
+    reference saved before its quantities were kept).
 
     With ``arrays=False`` only its seconds are read (t, u, beta, facets None):
     a study whose levels are all saved needs no more."""
@@ -92,20 +110,40 @@ def load_reference(path, scene, arrays=True):
             if int(data["refine"]) != scene.mesh.refine or int(data["steps"]) != scene.steps:
                 return None
             seconds = float(data["seconds"])
+            quantities = (json.loads(str(data["quantities"])) if "quantities" in data.files
+                          else None)
+            if quantity is not None and quantity not in (quantities or {}):
+                return None
             if not arrays:
-                return Reference(scene, None, None, None, None, seconds)
+                return Reference(scene, None, None, None, None, seconds, quantities)
             if data["t"].shape != (scene.steps + 1,) or data["u"].shape[0] != scene.steps + 1:
                 return None
             return Reference(scene, data["t"], data["u"], data["beta"], data["facets"],
-                             seconds)
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+                             seconds, quantities)
+    except (OSError, KeyError, ValueError, TypeError, zipfile.BadZipFile):
         return None
 
 
 # ---------------------------------------------------------------- results
 
 
-def results(records, param, reference_info):
+def quantity_errors(records, name, reference_value):
+    """The records with a study of quantity ``name``'s entries: ``quantity``
+    Q_h (the level's value), ``err_q`` = |Q_h − Q_ref| and ``rel_q`` =
+    err_q / |Q_ref| (None where Q_h or Q_ref is None, rel_q also where
+    Q_ref = 0)."""
+    out = []
+    for record in records:
+        value = (record.get("quantities") or {}).get(name)
+        err = (None if value is None or reference_value is None
+               else abs(float(value) - float(reference_value)))
+        rel = (None if err is None or reference_value == 0
+               else err / abs(float(reference_value)))
+        out.append({**record, "quantity": value, "err_q": err, "rel_q": rel})
+    return out
+
+
+def results(records, param, reference_info, quantity=None):
     """The ``rates.json`` document.
 
     Firm keys: ``{"param", "levels": [{"h", "k", "dofs", "err_u", "err_beta",
@@ -113,18 +151,35 @@ def results(records, param, reference_info):
     has its level, steps, refine, the relative errors rel_u, rel_beta,
     rel_E (None for a level saved without them, or a zero solution), the
     pairwise rate_E and its Newton iterations, and ``"reference"``
-    describes the reference."""
+    describes the reference.
+
+    With ``quantity`` (its name; ``reference_info["quantity"]`` then holds
+    Q_ref) each level also has ``quantity``, ``err_q``, ``rel_q`` (see
+    :func:`quantity_errors`) and the pairwise ``rate_q``, ``rates`` has
+    "Q", and the document ``"quantity": {"name", "reference"}``."""
+    if quantity is not None:
+        records = quantity_errors(records, quantity, reference_info.get("quantity"))
     pairwise = pairwise_rates(records, param)
+    pairwise_q = (pairwise_rates(records, param, key="err_q") if quantity is not None
+                  else [None] * len(records))
     levels = []
-    for record, rate in zip(records, pairwise):
-        levels.append({key: record[key] for key in ("h", "k", "dofs", "err_u", "err_beta",
-                                                     "E", "seconds")}
-                      | {key: _finite(record.get(key)) for key in RELATIVE_KEYS}
-                      | {"level": record["level"], "steps": record["steps"],
-                         "refine": record.get("refine"), "rate_E": rate,
-                         "newton_iterations": record.get("newton_iterations")})
-    return {"param": param, "levels": levels, "rates": rates(records, param),
-            "reference": reference_info}
+    for record, rate, rate_q in zip(records, pairwise, pairwise_q):
+        row = ({key: record[key] for key in ("h", "k", "dofs", "err_u", "err_beta",
+                                              "E", "seconds")}
+               | {key: _finite(record.get(key)) for key in RELATIVE_KEYS}
+               | {"level": record["level"], "steps": record["steps"],
+                  "refine": record.get("refine"), "rate_E": rate,
+                  "newton_iterations": record.get("newton_iterations")})
+        if quantity is not None:
+            row |= {"quantity": _finite(record["quantity"]), "err_q": _finite(record["err_q"]),
+                    "rel_q": _finite(record["rel_q"]), "rate_q": rate_q}
+        levels.append(row)
+    document = {"param": param, "levels": levels,
+                "rates": rates(records, param, quantity=quantity is not None),
+                "reference": reference_info}
+    if quantity is not None:
+        document["quantity"] = {"name": quantity, "reference": reference_info.get("quantity")}
+    return document
 
 
 def _finite(value):
@@ -144,14 +199,18 @@ def trust(document):
     finest level (fewer than 2 extra refinements in h, 4× the steps in k)."""
     out = []
     levels = document["levels"]
-    for a, b in zip(levels[:-1], levels[1:]):
-        if not (b["E"] is not None and a["E"] is not None and b["E"] < a["E"]):
-            out.append(f"E does not decrease from level {a['level']} to {b['level']} "
-                       f"({a['E']:.3g} to {b['E']:.3g})")
-    pairwise = [row["rate_E"] for row in levels if row["rate_E"] is not None]
-    if pairwise and (min(pairwise) < 0 or max(pairwise) - min(pairwise) > RATE_SPREAD):
-        out.append(f"the pairwise rates of E scatter from {min(pairwise):.2f} to "
-                   f"{max(pairwise):.2f}: the fitted rate is not a trustworthy summary")
+    checked = [("E", "E", "rate_E")]
+    if "quantity" in document:
+        checked.append((f"|Q − Q_ref| of {document['quantity']['name']}", "err_q", "rate_q"))
+    for label, key, rate_key in checked:
+        for a, b in zip(levels[:-1], levels[1:]):
+            if not (b[key] is not None and a[key] is not None and b[key] < a[key]):
+                out.append(f"{label} does not decrease from level {a['level']} to "
+                           f"{b['level']} ({_fmt_error(a[key])} to {_fmt_error(b[key])})")
+        pairwise = [row[rate_key] for row in levels if row[rate_key] is not None]
+        if pairwise and (min(pairwise) < 0 or max(pairwise) - min(pairwise) > RATE_SPREAD):
+            out.append(f"the pairwise rates of {label} scatter from {min(pairwise):.2f} to "
+                       f"{max(pairwise):.2f}: the fitted rate is not a trustworthy summary")
     ref = document.get("reference") or {}
     if ref.get("kind") == "fine":
         if document["param"] in ("h", "hk") and (ref.get("ref_h") or 0) < 2:
@@ -165,20 +224,30 @@ def trust(document):
     return out
 
 
+def _fmt_error(value):
+    return "none" if value is None else f"{value:.3g}"
+
+
+def csv_columns(document):
+    """The columns of ``errors.csv``: :data:`CSV_COLUMNS`, and
+    :data:`QUANTITY_COLUMNS` for a study of a quantity."""
+    return CSV_COLUMNS + (QUANTITY_COLUMNS if "quantity" in document else ())
+
+
 def error_rows(document):
-    """The rows of ``errors.csv`` (:data:`CSV_COLUMNS`), one per level: floats
+    """The rows of ``errors.csv`` (:func:`csv_columns`), one per level: floats
     as repr, None (a rate_E on the first level, a NaN, a relative error of
     a zero solution or of a level saved without it) as an empty cell."""
     return [["" if row[key] is None else
              (repr(float(row[key])) if isinstance(row[key], float) else row[key])
-             for key in CSV_COLUMNS] for row in document["levels"]]
+             for key in csv_columns(document)] for row in document["levels"]]
 
 
 def write_errors_csv(path, document):
-    """``errors.csv``: a header of :data:`CSV_COLUMNS`, then :func:`error_rows`."""
+    """``errors.csv``: a header of :func:`csv_columns`, then :func:`error_rows`."""
     def write(f):
         writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(CSV_COLUMNS)
+        writer.writerow(csv_columns(document))
         writer.writerows(error_rows(document))
     write_atomic(path, write)
 
@@ -197,7 +266,8 @@ def _setup(source, base, param, levels, ref_h, ref_k, reference):
 
 
 def _compute_level(state, level):
-    return run_level(state.scene, state.param, level, state.reference)
+    return run_level(state.scene, state.param, level, state.reference,
+                     measure=scalar_quantities)
 
 
 # ---------------------------------------------------------------- the study
@@ -250,6 +320,11 @@ class ConvergenceStudy(Study):
     scene_file : str, optional
         Recorded in ``study.json`` (not part of the identity); the path by
         default when ``scene`` is one.
+    quantity : str, optional
+        A scalar quantity whose error |Q_h − Q_ref| against the fine
+        reference is fitted beside the norms (a name of
+        :func:`~adhesive_contact.postprocess.scalars.quantity_names`);
+        needs reference "fine" (the default then).
 
     Raises
     ------
@@ -263,7 +338,7 @@ class ConvergenceStudy(Study):
     compute = _compute_level
 
     def __init__(self, scene, param, levels=5, reference=None, *, folder, ref_h=None,
-                 ref_k=None, refine=None, steps=None, scene_file=None):
+                 ref_k=None, refine=None, steps=None, scene_file=None, quantity=None):
         super().__init__(folder)
         if scene_file is None and not isinstance(scene, (str, dict)):
             scene_file = str(scene)
@@ -278,7 +353,18 @@ class ConvergenceStudy(Study):
         self.scene = with_discretisation(given, refine, steps)
         self.param, self.levels = param, levels
         if reference is None:
-            reference = "exact" if self.scene.exact is not None else "fine"
+            reference = ("exact" if self.scene.exact is not None and quantity is None
+                         else "fine")
+        if quantity is not None:
+            allowed = quantity_names(build_problem(self.scene))
+            if quantity not in allowed:
+                raise StudyError("quantity", f"no quantity {quantity!r} in this scene; "
+                                 f"allowed: {', '.join(allowed)}")
+            if reference == "exact":
+                raise StudyError("quantity", f"{quantity!r} is not computable from the "
+                                 "scene's [exact] solution (it gives u and β, not reactions "
+                                 "or energies); allowed with a quantity: reference fine")
+        self.quantity = quantity
         if reference not in ("exact", "fine"):
             raise StudyError("reference", f"must be exact or fine, got {reference!r}")
         if reference == "exact" and self.scene.exact is None:
@@ -303,8 +389,12 @@ class ConvergenceStudy(Study):
     # -- identity and runs
 
     def identity(self):
-        return {"scene": scene_identity(self.scene), "param": self.param, "levels": self.levels,
-                "reference": self.reference, "ref_h": self.ref_h, "ref_k": self.ref_k}
+        identity = {"scene": scene_identity(self.scene), "param": self.param,
+                    "levels": self.levels, "reference": self.reference, "ref_h": self.ref_h,
+                    "ref_k": self.ref_k}
+        if self.quantity is not None:   # absent without one: older studies keep their sha
+            identity["quantity"] = self.quantity
+        return identity
 
     def keys(self):
         return list(range(self.levels))
@@ -314,7 +404,9 @@ class ConvergenceStudy(Study):
 
     def valid(self, level, record):
         return (isinstance(record, dict) and record.get("level") == level
-                and all(key in record for key in RECORD_KEYS))
+                and all(key in record for key in RECORD_KEYS)
+                and (self.quantity is None
+                     or self.quantity in (record.get("quantities") or {})))
 
     def load(self):
         """{level: record} of the saved levels, null errors read back as NaN."""
@@ -350,7 +442,8 @@ class ConvergenceStudy(Study):
     def _fine_reference(self, arrays, progress):
         """(reference, loaded): from ``reference.npz``, else run and saved."""
         rscene = self.reference_scene
-        fine = load_reference(self.folder / REFERENCE, rscene, arrays=arrays)
+        fine = load_reference(self.folder / REFERENCE, rscene, arrays=arrays,
+                              quantity=self.quantity)
         if fine is not None:
             return fine, True
         total = rscene.steps + 1
@@ -358,7 +451,8 @@ class ConvergenceStudy(Study):
 
         def compute(state, key):
             return run_reference(self.scene, self.param, self.levels, self.ref_h, self.ref_k,
-                                 progress=lambda n, N: progress("reference", n + 1, total))
+                                 progress=lambda n, N: progress("reference", n + 1, total),
+                                 measure=scalar_quantities)
 
         _, fine, message = attempt(compute, None, "reference")
         if message is not None:
@@ -403,6 +497,8 @@ class ConvergenceStudy(Study):
             rscene = fine.scene
             info |= {"ref_h": self.ref_h, "ref_k": self.ref_k, "refine": rscene.mesh.refine,
                      "steps": rscene.steps, "k": rscene.k, "seconds": fine.seconds}
+            if self.quantity is not None:
+                info["quantity"] = fine.quantities[self.quantity]
         progress("levels", len(done), self.levels)
         setup, args = self.context(fine)
         computed = self.run_missing(
@@ -412,7 +508,7 @@ class ConvergenceStudy(Study):
         records = [done[level] for level in self.keys()]
         if self.reference == "fine":
             info["h"] = records[-1]["h"] / 2 ** self.ref_h
-        document = results(records, self.param, info)
+        document = results(records, self.param, info, self.quantity)
         document["warnings"] = trust(document)
         document["trustworthy"] = not document["warnings"]
         files = ["errors.csv", "rates.json"]

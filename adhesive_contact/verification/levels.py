@@ -80,17 +80,20 @@ class Reference:
     beta: np.ndarray     # (N+1, nf)
     facets: np.ndarray   # contact facets of the fine mesh, in Γ_C order
     seconds: float
+    quantities: dict = None   # its scalar quantities (postprocess.scalars), None if not kept
 
 
-def run_reference(scene, param, levels, ref_h=None, ref_k=None, progress=None):
-    """Solve the reference run of a study (``progress(n, N)`` per step)."""
+def run_reference(scene, param, levels, ref_h=None, ref_k=None, progress=None, measure=None):
+    """Solve the reference run of a study (``progress(n, N)`` per step);
+    ``measure(solution)``, optional, gives its ``quantities`` (a dict)."""
     ref = reference_scene(scene, param, levels, ref_h, ref_k)
     t0 = time.perf_counter()
     problem = build_problem(ref)
     solution = solve(problem, progress, raise_on_failure=True)
     facets = problem.boundary.facets if problem.boundary is not None else np.zeros(0, int)
-    return Reference(ref, solution.t, solution.u, solution.beta, facets,
-                     time.perf_counter() - t0)
+    seconds = time.perf_counter() - t0
+    return Reference(ref, solution.t, solution.u, solution.beta, facets, seconds,
+                     None if measure is None else measure(solution))
 
 
 def _errors_against_reference(problem, solution, reference):
@@ -156,7 +159,7 @@ def relative(error, norm):
     return float(np.max(error)) / size if size > 0 else float("nan")
 
 
-def run_level(scene, param, level, reference=None, progress=None):
+def run_level(scene, param, level, reference=None, progress=None, measure=None):
     """Solve one level and measure its errors: a JSON-able record.
 
     ``reference`` is a :class:`Reference`, or None to use the scene's exact
@@ -172,6 +175,11 @@ def run_level(scene, param, level, reference=None, progress=None):
     err_u / max_n ‖ε(u(t_n))‖, ``rel_beta`` = err_beta / max_n ‖β(t_n)‖,
     ``rel_E`` = E / max_n (‖ε(u(t_n))‖ + ‖β(t_n)‖). ``h`` is the largest
     edge length of the level's mesh (its largest cell diameter), ``k`` = T/N.
+    With ``measure``, a callable of the solution giving a dict of scalars
+    (the studies pass
+    :func:`~adhesive_contact.postprocess.scalars.scalar_quantities`), the
+    record has them as ``quantities``, from which a study of a quantity
+    measures |Q_h − Q_ref|.
     """
     lscene = level_scene(scene, param, level)
     t0 = time.perf_counter()
@@ -185,7 +193,7 @@ def run_level(scene, param, level, reference=None, progress=None):
     else:
         err_u, err_b, norm_u, norm_b = _errors_against_reference(problem, solution, reference)
     E = err_u + err_b
-    return {
+    record = {
         "level": level, "h": mesh_size(problem.mesh), "k": lscene.k,
         "dofs": int(problem.ndofs), "steps": lscene.steps, "refine": lscene.mesh.refine,
         "err_u": float(err_u.max()), "err_beta": float(err_b.max()), "E": float(E.max()),
@@ -195,3 +203,6 @@ def run_level(scene, param, level, reference=None, progress=None):
         "stepping_seconds": solution.timings["stepping"],
         "newton_iterations": int(solution.iterations.sum()),
     }
+    if measure is not None:
+        record["quantities"] = measure(solution)
+    return record

@@ -1,5 +1,6 @@
 """The figures of the studies: a convergence study's ``error_vs_h.png`` (or
-``error_vs_k.png``) and ``work_precision.png``, drawn from its results
+``error_vs_k.png``), ``work_precision.png`` and, for a study of a scalar
+quantity, ``quantity_vs_h.png`` (or ``_vs_k``), drawn from its results
 document (``rates.json``), and a sweep's ``by_<key>.png``, one per swept
 key, drawn from its rows (``runs.csv``)."""
 
@@ -198,7 +199,63 @@ def write_convergence_plots(out, document, title, units=None):
     names = [f"error_vs_{size}.png", "work_precision.png"]
     plot_error_vs_size(out / names[0], document, title, Units(units))
     plot_work_precision(out / names[1], document, title)
+    if "quantity" in document:
+        names.append(f"quantity_vs_{size}.png")
+        save_figure(figure_quantity_vs_size(document, title, Units(units)), out / names[-1])
     return names
+
+
+def figure_quantity_vs_size(document, title, units=None):
+    """A study of a scalar quantity Q: Q_h per level against h (or k) with the
+    reference's Q_ref as a dashed line (left), and |Q_h − Q_ref| log-log
+    with its fitted slope and a slope-1 guide (right).
+
+    Parameters
+    ----------
+    document : dict
+        The results document of a convergence study of a quantity
+        (``rates.json`` with ``"quantity"``).
+    title : str
+        The scene's title.
+    units : Units, optional
+        The scene's units, naming the unit of h and k.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    units = units or Units()
+    param, name = document["param"], document["quantity"]["name"]
+    size = "k" if param == "k" else "h"
+    rows = document["levels"]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.6))
+    x = np.asarray([r[size] for r in rows], float)
+    q = np.array([np.nan if r["quantity"] is None else r["quantity"] for r in rows], float)
+    left.semilogx(x, q, "o-", label=f"{name}, level")
+    reference = document["quantity"]["reference"]
+    if reference is not None:
+        left.axhline(reference, linestyle="--", color="0.5",
+                     label=f"fine reference: {reference:.6g}")
+    left.legend(fontsize="small", loc="best")
+    left.set_ylabel(name)
+    xe, ye = _positive(x, [r["err_q"] for r in rows])
+    if ye.size:
+        slope = _fmt(document["rates"].get("Q"), ".2f", "n/a")
+        right.loglog(xe, ye, "D-", label=f"|Q_h − Q_ref|   slope {slope}")
+        _slope_one_triangle(right, xe, ye)
+        right.legend(fontsize="small", loc="best")
+    else:
+        right.text(0.5, 0.5, "no nonzero error", transform=right.transAxes, ha="center")
+    right.set_ylabel(f"|Q_h − Q_ref| of {name}")
+    length, time = units.suffix("length"), units.suffix("time")
+    label = {"h": f"mesh size h{length}", "k": f"time step k{time}",
+             "hk": f"mesh size h{length} (k halved with h)"}[param]
+    for ax in (left, right):
+        ax.set_xlabel(label)
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.grid(True, which="both", color="0.9", linewidth=0.6)
+    _suptitle(fig, document, title)
+    return fig
 
 
 # ---------------------------------------------------------------- sweep
