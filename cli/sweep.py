@@ -58,7 +58,7 @@ def table(rows, keys):
     return lines
 
 
-def guard_variants(source, settings, grid, force):
+def guard_variants(source, settings, grid, force, base_dir=None):
     """Refuse (exit 2) a sweep with a variant larger than the machine, before
     any variant's mesh is built (:func:`~.common.guard`); ``source`` is the
     decoded scene document."""
@@ -66,7 +66,7 @@ def guard_variants(source, settings, grid, force):
         return
     for values in variants(settings, "grid" if grid else "zip"):
         try:
-            scene = scene_from_dict(variant_document(source, values))
+            scene = scene_from_dict(variant_document(source, values), base_dir)
         except (SceneError, ValueError):
             continue   # the sweep names the setting at fault
         where = ", ".join(f"{k}={toml_value(v)}" for k, v in values.items())
@@ -114,8 +114,9 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
     def make():
         settings = [parse_assignment(a) for a in assignments]
         source = study_source(text, scene_folder(scene))
-        guard_variants(source, settings, grid, force)
-        return Sweep(source, settings, "grid" if grid else "zip", folder=out)
+        guard_variants(source, settings, grid, force, scene_folder(scene))
+        return Sweep(source, settings, "grid" if grid else "zip", folder=out,
+                     base_dir=scene_folder(scene))
 
     study = open_study(make, out, "sweep")
     executor = open_executor(scheduler, jobs)

@@ -228,3 +228,62 @@ def test_sweep_from_python_with_progress(tmp_path, capsys):
     assert "did not converge" in result.records[0]["failure"]["message"]
     assert result.computed == [0, 1]
     assert np.isfinite(result.rows[1]["normal_force_T"])
+
+
+# ---------------------------------------------------------------- a swept mesh file
+
+
+def write_rectangle_msh(path, cells):
+    """A 2 × 0.5 rectangle of ``cells`` triangles per side as gmsh 2.2, with
+    the named sides top and foot (the bottom)."""
+    import meshio
+    from skfem import MeshTri
+
+    mesh = MeshTri.init_tensor(np.linspace(0, 2, 2 * cells + 1),
+                               np.linspace(0, 0.5, cells // 2 + 1))
+    mesh = mesh.with_boundaries({"top": lambda x: np.isclose(x[1], 0.5),
+                                 "foot": lambda x: np.isclose(x[1], 0.0)})
+    blocks = [("line", mesh.facets[:, mesh.boundaries[s]].T) for s in ("top", "foot")]
+    blocks.append(("triangle", mesh.t.T))
+    tags = [np.full(len(b[1]), i + 1) for i, b in enumerate(blocks)]
+    meshio.write(path, meshio.Mesh(
+        np.column_stack([mesh.p.T, np.zeros(mesh.p.shape[1])]), blocks,
+        cell_data={"gmsh:physical": tags, "gmsh:geometrical": tags},
+        field_data={"top": np.array([1, 1]), "foot": np.array([2, 1]),
+                    "body": np.array([3, 2])}), file_format="gmsh22", binary=False)
+
+
+FILE_SCENE = scene_dict({
+    "mesh": {"domain": "file", "file": "m1.msh"},
+    "boundary": {"dirichlet": ["top"], "contact": ["foot"]},
+    "loads": {"body": ["0", "-10*t"]},
+    "contact": {"normal": {"law": "compliance", "c": 100.0}}, "time.steps": 2})
+
+
+def test_a_swept_mesh_file_is_the_scene_folders_and_its_content_is_the_sweeps(
+        tmp_path, monkeypatch):
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    write_rectangle_msh(scenes / "m1.msh", 4)
+    write_rectangle_msh(scenes / "m2.msh", 8)
+    write_rectangle_msh(tmp_path / "m2.msh", 16)   # a decoy in the working directory
+    scene = scenes / "scene.toml"
+    scene.write_text(to_toml(FILE_SCENE))
+    monkeypatch.chdir(tmp_path)
+    args = [scene, "--set", 'mesh.file="m2.msh"', "--out", tmp_path / "out"]
+    result = run(*args)
+    assert result.exit_code == 0, result.output
+    [row] = read_rows(tmp_path / "out" / "runs.csv")
+
+    def force(folder):   # the scene's own m2.msh, read by the library from its file
+        variant = folder / "variant.toml"
+        variant.write_text(to_toml(scene_dict({"mesh.file": "m2.msh"}, FILE_SCENE)))
+        from adhesive_contact import load_scene
+        return solve(build_problem(load_scene(variant))).total_normal_force()[-1]
+
+    assert float(row["normal_force_T"]) == pytest.approx(force(scenes), rel=1e-12)
+    assert abs(float(row["normal_force_T"]) - force(tmp_path)) > 1e-6 * abs(force(tmp_path))
+    # the mesh file changes: the folder holds another sweep, nothing is reused
+    write_rectangle_msh(scenes / "m2.msh", 6)
+    result = run(*args)
+    assert_one_line_error(result, 2, "holds a different sweep (files")

@@ -30,12 +30,14 @@ From Python::
 
 import copy
 import csv
+import hashlib
 import itertools
 import re
 import resource
 import time
 import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.quantities import beta_mean
@@ -168,6 +170,24 @@ def variants(settings, mode="grid"):
     return [dict(zip(keys, combo)) for combo in combos]
 
 
+def file_sha256(given, base_dir=None):
+    """The sha256 of the file ``given`` (relative to ``base_dir``), None when
+    it cannot be read (the variant's check then names it)."""
+    path = Path(given).expanduser()
+    if not path.is_absolute():
+        path = Path(base_dir if base_dir is not None else Path.cwd()) / path
+    try:
+        if not path.is_file():
+            return None
+        digest = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                digest.update(block)
+        return digest.hexdigest()
+    except (OSError, RuntimeError):
+        return None
+
+
 def variant_document(document, values):
     """The TOML document of one variant: ``document`` with every setting applied."""
     for key, value in values.items():
@@ -197,8 +217,9 @@ def _at_T(values):
     return None if values is None else values[-1]
 
 
-def run_variant(document, values):
-    """Build and solve one variant; its record (plain JSON).
+def run_variant(document, values, base_dir=None):
+    """Build and solve one variant; its record (plain JSON). A relative
+    ``mesh.file`` is taken in ``base_dir`` (the scene file's folder).
 
     Keys: ``values`` ({key: value}), ``outcome`` ("ok" or "failed"),
     ``failure`` (None, or {step, t, residual, iterations, message}),
@@ -215,7 +236,7 @@ def run_variant(document, values):
     needs the solution.
     """
     t0 = time.perf_counter()
-    problem = build_problem(scene_from_dict(variant_document(document, values)))
+    problem = build_problem(scene_from_dict(variant_document(document, values), base_dir))
     solution, failure = solve_or_failure(problem)
     record = {"values": values, "seconds": time.perf_counter() - t0,
               "worker_peak_rss_mib": peak_rss_mib()}
@@ -240,13 +261,13 @@ def run_variant(document, values):
         "normal_force_T": solution.total_normal_force()[-1]})
 
 
-def _setup(document, runs):
-    return document, runs
+def _setup(document, runs, base_dir=None):
+    return document, runs, base_dir
 
 
 def _compute_run(state, key):
-    document, runs = state
-    return {"run": key} | run_variant(document, runs[key])
+    document, runs, base_dir = state
+    return {"run": key} | run_variant(document, runs[key], base_dir)
 
 
 # ---------------------------------------------------------------- rows
@@ -324,6 +345,12 @@ class Sweep(Study):
         Dotted TOML keys and their values (see the module docstring).
     mode : {"grid", "zip"}
     folder : path of the sweep's folder
+    base_dir : the folder a relative ``mesh.file`` (of the scene or of a
+        setting) is taken in; by default the scene file's folder (the
+        working directory for a text or a document)
+
+    The study's identity holds the sha256 of every mesh file a variant
+    reads, so a sweep whose mesh file changed is another sweep.
 
     Raises
     ------
@@ -337,10 +364,13 @@ class Sweep(Study):
     runs_folder = "runs"
     compute = _compute_run
 
-    def __init__(self, scene, settings, mode="grid", *, folder):
+    def __init__(self, scene, settings, mode="grid", *, folder, base_dir=None):
         super().__init__(folder)
+        if base_dir is None and not isinstance(scene, (str, dict)):
+            base_dir = Path(scene).absolute().parent
+        self.base_dir = None if base_dir is None else str(Path(base_dir).absolute())
         self.source = scene_source(scene)
-        self.base = scene_from_dict(self.source)
+        self.base = scene_from_dict(self.source, self.base_dir)
         self.settings = [(key, list(values)) for key, values in settings]
         self.mode = mode
         self.runs = variants(self.settings, mode)
@@ -359,7 +389,7 @@ class Sweep(Study):
             except ValueError as err:
                 raise StudyError(f"set {key}", str(err)) from None
         try:
-            return build_problem(scene_from_dict(document))
+            return build_problem(scene_from_dict(document, self.base_dir))
         except SceneError as err:
             if err.key in values:
                 reason = str(err).removeprefix(f"{err.key}: ")
@@ -369,8 +399,20 @@ class Sweep(Study):
                 from None
 
     def identity(self):
-        return {"scene": scene_identity(self.base), "set": [[k, v] for k, v in self.settings],
-                "mode": self.mode}
+        identity = {"scene": scene_identity(self.base),
+                    "set": [[k, v] for k, v in self.settings], "mode": self.mode}
+        files = self.files_read()
+        return identity | ({"files": files} if files else {})
+
+    def files_read(self):
+        """[[value, sha256], ...] of the mesh files that the settings name
+        (the base scene's own is in its resolved record), in the order set."""
+        files = []
+        for key, values in self.settings:
+            if key == "mesh.file":
+                for value in dict.fromkeys(v for v in values if isinstance(v, str)):
+                    files.append([value, file_sha256(value, self.base_dir)])
+        return files
 
     def keys(self):
         return list(range(len(self.runs)))
@@ -384,7 +426,7 @@ class Sweep(Study):
                 and record.get("values") == plain(self.runs[key]))
 
     def context(self):
-        return _setup, (self.source, self.runs)
+        return _setup, (self.source, self.runs, self.base_dir)
 
     def run(self, jobs=1, executor=None, as_completed=None, progress=None):
         """Compute the runs not saved yet, then write ``runs.csv``.
