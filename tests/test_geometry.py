@@ -267,6 +267,30 @@ def test_foundation_gap_along_the_nodal_normal():
     assert g[hit].min() == pytest.approx(0.1, abs=2e-3) and hit.sum() < hit.size
 
 
+@pytest.mark.parametrize("key, vector, dim", [
+    ("normal", [0.0, 5e-324], 2), ("normal", [1e-300, 1e308], 2), ("normal", [0.0, 1e-170], 2),
+    ("axis", [0.0, 0.0, 5e-324], 3)])
+def test_a_foundation_direction_whose_length_under_or_overflows_is_refused(key, vector, dim):
+    # |v|² is 0 or inf in floating point: v/|v| removed the wall without a word
+    foundation = ({"point": [0.0, -0.1], "normal": vector} if key == "normal" else
+                  {"shape": "cylinder", "point": [0.0, -2.0, 0.0], "axis": vector,
+                   "radius": 1.9})
+    scene = file_scene(HALF_DISC if dim == 2 else CYLINDER, {
+        "contact.normal": law("compliance", c=1e3), "contact.foundation": foundation},
+        dim=dim)
+    with pytest.raises(SceneError, match=rf"^contact\.foundation\.{key}: .* has a length "
+                                         r"whose square (under|over)flows in floating "
+                                         r"point; give the direction with components of "
+                                         r"moderate size, e\.g\. \[0, 1\]$"):
+        scene_from_dict(scene)
+    # the same direction scaled to moderate size is a wall
+    scale = max(abs(c) for c in vector)
+    moderate = [c / scale for c in vector]
+    scene["contact"]["foundation"][key] = moderate
+    problem = build_problem(scene_from_dict(scene))
+    assert np.isfinite(problem.gap[0]).any()
+
+
 def test_cylinder_foundation_in_3d():
     p = build_problem(scene_from_dict(file_scene(CYLINDER, {
         "contact.normal": law("compliance", c=1e3), "contact.foundation": {

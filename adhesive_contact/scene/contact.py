@@ -3,6 +3,7 @@ foundation), the quadrature on Γ_C, and the normal, friction and bonding
 laws of :mod:`adhesive_contact.laws`."""
 
 import math
+import sys
 
 from ..laws import FRICTION_LAWS
 from .errors import SceneError
@@ -102,6 +103,12 @@ def _point(table, name, dim, nonzero=False):
         raise SceneError(table.key(name), f"must be a list of {dim} numbers, got {show(value)}")
     if nonzero and not any(value):
         raise SceneError(table.key(name), "must be a nonzero vector")
+    squared = sum(float(c) * float(c) for c in value)
+    if nonzero and not sys.float_info.min <= squared <= sys.float_info.max:
+        # |v|² under- or overflows: the unit vector v/|v| would be 0 or NaN
+        raise SceneError(table.key(name), f"{show(value)} has a length whose square "
+                         f"{'underflows' if squared < 1 else 'overflows'} in floating point; "
+                         "give the direction with components of moderate size, e.g. [0, 1]")
     return tuple(float(c) for c in value)
 
 
