@@ -89,8 +89,12 @@ def guard(scene, force=False, out=None, what="the scene"):
     checked), None not to check the disk."""
     if force:
         return
-    from adhesive_contact.resources import estimate, free_disk, refusal
+    from adhesive_contact.resources import estimate, free_disk, mesh_file_refusal, refusal
 
+    reason = mesh_file_refusal(scene)   # before the estimate reads the file
+    if reason:
+        raise CliError(f"mesh.file: {what} is too large for this machine: {reason}; use a "
+                       "smaller mesh, or --force to read it anyway", 2)
     est = estimate(scene)
     reason = refusal(est, disk=None if out is None else free_disk(out))
     if reason:

@@ -5,6 +5,10 @@ The committed meshes are made by studies/meshes/make_meshes.py (gmsh); the
 tests also write small meshes with meshio to check what the reader refuses.
 """
 
+import json
+import os
+import subprocess
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -371,3 +375,44 @@ def test_builtin_sides_and_facets_equal_scikit_fems_own(spec):
     for name, facets in own.boundaries.items():
         assert facets.size > 0
         np.testing.assert_array_equal(mesh.boundaries[name], facets)
+
+
+# ---------------------------------------------------------------- mesh paths that are not files
+
+
+@pytest.mark.parametrize("make, needle", [
+    (lambda d: os.mkfifo(d / "m.msh") or "m.msh", "is a named pipe (FIFO), not a regular file"),
+    (lambda d: "/dev/zero", "'/dev/zero' is a device, not a regular file"),
+    (lambda d: (d / "m.msh").mkdir() or "m.msh", "is a folder, not a regular file"),
+    (lambda d: "~nosuchuser12345/m.msh", "no such user's home folder (~nosuchuser12345)"),
+    (lambda d: "m\0.msh", "mesh.file: the path holds a NUL character"),
+])
+def test_a_mesh_path_that_is_not_a_regular_file_is_one_line_exit_2(tmp_path, make, needle):
+    # a FIFO blocked the read for ever, /dev/zero ran out of memory, the rest
+    # were tracebacks; in a child, so that a hang fails the test
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(file_scene(make(tmp_path))))
+    result = subprocess.run([sys.executable, "-c", "from adhesive_contact_cli.main import "
+                             "main; main()", "solve", str(scene), "--out", str(tmp_path / "o")],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: mesh.file: ") and needle in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_load_solution_of_a_scene_text_naming_a_fifo_is_refused(tmp_path):
+    from adhesive_contact import OutputFolderError, load_solution
+
+    (tmp_path / "m.msh").write_bytes(HALF_DISC.read_bytes())
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(file_scene("m.msh")))
+    out = tmp_path / "out"
+    assert CliRunner().invoke(main, ["solve", str(scene), "--out", str(out)]).exit_code == 0
+    os.mkfifo(tmp_path / "pipe.msh")
+    summary = json.loads((out / "summary.json").read_text())
+    summary["source"]["text"] = summary["source"]["text"].replace("m.msh", "pipe.msh")
+    (out / "summary.json").write_text(json.dumps(summary))
+    with pytest.raises(OutputFolderError, match="its scene cannot be built here: mesh.file: "
+                       ".*pipe.msh' is a named pipe"):
+        load_solution(out)

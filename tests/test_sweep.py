@@ -64,9 +64,9 @@ def counting(monkeypatch):
     calls = []
     real = sweep_module.run_variant
 
-    def run_variant(document, values):
+    def run_variant(document, values, base_dir=None):
         calls.append(dict(values))
-        return real(document, values)
+        return real(document, values, base_dir)
 
     monkeypatch.setattr(sweep_module, "run_variant", run_variant)
     return calls
