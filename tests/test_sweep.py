@@ -3,11 +3,13 @@ settings parsed as TOML values, every variant validated before anything
 runs, failed runs as rows, runs.csv against direct solves, resume."""
 
 import csv
+import time
 import shutil
 
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
+from adhesive_contact_cli.sweep import table
 from conftest import assert_one_line_error, runner, scene_dict, to_toml, wall_block
 
 import adhesive_contact.studies.sweep as sweep_module
@@ -287,3 +289,49 @@ def test_a_swept_mesh_file_is_the_scene_folders_and_its_content_is_the_sweeps(
     write_rectangle_msh(scenes / "m2.msh", 6)
     result = run(*args)
     assert_one_line_error(result, 2, "holds a different sweep (files")
+
+
+# ---------------------------------------------------------------- many variants
+
+
+@pytest.mark.parametrize("sets, count, sizes", [
+    (("contact.normal.c=" + ",".join(str(100 + i) for i in range(100)),
+      "solver.max_iter=" + ",".join(str(10 + i) for i in range(100))), "10,000", "100 x 100"),
+    (("contact.normal.c=" + ",".join(str(100 + i) for i in range(1000)),
+      "solver.max_iter=" + ",".join(str(10 + i) for i in range(1000))), "1,000,000",
+     "1000 x 1000"),
+])
+def test_more_variants_than_the_maximum_are_refused_at_once(scene_file, tmp_path, counting,
+                                                           sets, count, sizes):
+    # every variant was built and validated first: no answer for 10^4 or 10^6
+    started = time.perf_counter()
+    result = run(scene_file, *[x for s in sets for x in ("--set", s)], "--out", tmp_path / "o")
+    assert time.perf_counter() - started < 20
+    assert_one_line_error(result, 2, f"--set: gives {count} variants ({sizes}); at most "
+                          "1,000 unless forced (--force): each variant is a run")
+    assert counting == [] and not (tmp_path / "o").exists()
+
+
+def test_each_value_is_checked_once_and_a_bad_combination_is_a_failed_row(tmp_path,
+                                                                         monkeypatch):
+    built = []
+    real = sweep_module.build_problem
+    monkeypatch.setattr(sweep_module, "build_problem",
+                        lambda scene: built.append(scene) or real(scene))
+    settings = [("contact.normal.c", [1e3, 2e3, 3e3]), ("solver.max_iter", [20, 30, 40, 50])]
+    sweep = Sweep(SCENE, settings, folder=tmp_path / "out")
+    assert sweep.checked() == [0, 1, 2, 3, 4, 8]   # 3 + 4 - 1 builds, not 12
+    assert len(built) == 6
+    # values valid one by one, not together: 20 x 0.5 in 8 x 300 cells are
+    # 2.5 x 0.00167, elongated 1500:1 (at most 1000:1)
+    combo = [("mesh.size", [[2.0, 0.5], [20.0, 0.5]]), ("mesh.cells", [[8, 4], [8, 300]])]
+    sweep = Sweep(SCENE, combo, folder=tmp_path / "combo")
+    assert sweep.checked() == [0, 1, 2]
+    result = sweep.run()
+    assert [r["outcome"] for r in result.records] == ["ok", "ok", "ok", "failed"]
+    failure = result.records[3]["failure"]
+    assert failure["step"] is None and failure["message"].startswith(
+        "not a valid scene: mesh.cells: cells of 2.5 x 0.00167 are elongated more than 1000:1")
+    lines = table(result.rows, sweep.keys_set)
+    assert lines[3].startswith("run   3: mesh.size=[20.0, 0.5], mesh.cells=[8, 300]: FAILED: "
+                               "not a valid scene: mesh.cells: cells of 2.5 x 0.00167")

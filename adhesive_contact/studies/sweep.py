@@ -4,9 +4,10 @@ A setting is a dotted TOML key and its values, e.g.
 ``("contact.normal.c", [1e2, 1e3])`` or ``("time.steps", [10, 20])``; an
 integer part indexes an array of tables (``contact.friction.0.mu``). The
 variants are the grid of all combinations (``mode="grid"``, the last key
-varying fastest) or the settings taken in step (``"zip"``, equal lengths).
-Every variant's scene is validated (parsed and discretised) before
-anything runs.
+varying fastest) or the settings taken in step (``"zip"``, equal lengths),
+at most :data:`MAX_VARIANTS` unless forced. Each value of each setting is
+validated (parsed and discretised) before anything runs; a combination of
+valid values that is not a valid scene is a failed run.
 
 A run that fails (a step solve that did not converge) is a result, not an
 error: its record says where it stopped. A run whose worker died (a killed
@@ -31,6 +32,7 @@ From Python::
 import copy
 import csv
 import hashlib
+import math
 import itertools
 import re
 import resource
@@ -46,6 +48,9 @@ from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 
 MODES = ("grid", "zip")
+#: the most variants a sweep has unless forced: each is a run (10⁴ variants
+#: were minutes of validation alone, 10⁶ hours)
+MAX_VARIANTS = 1000
 OUTCOMES = ("ok", "failed")
 #: the outcome of a run whose worker died: a row, never a saved record
 LOST = "lost"
@@ -142,11 +147,19 @@ def with_value(document, key, value):
     return out
 
 
-def variants(settings, mode="grid"):
+def variant_count(settings, mode="grid"):
+    """How many variants the settings give (without making them)."""
+    lengths = [len(list(values)) for _, values in settings]
+    return (math.prod(lengths) if mode == "grid" else min(lengths)) if lengths else 0
+
+
+def variants(settings, mode="grid", force=False):
     """The variants of a sweep: a list of {key: value}, in run order.
 
     Raises :class:`StudyError` for an unknown mode, no settings, a key set
-    twice or (zip) lists of different lengths."""
+    twice, (zip) lists of different lengths, or more than
+    :data:`MAX_VARIANTS` variants unless ``force`` (counted before any is
+    made)."""
     if mode not in MODES:
         raise StudyError("mode", f"must be grid or zip, got {mode!r}")
     settings = [(key, list(values)) for key, values in settings]
@@ -158,6 +171,13 @@ def variants(settings, mode="grid"):
             raise StudyError(f"set {key}", "set twice; give all its values in one --set")
         if not values:
             raise StudyError(f"set {key}", "no values")
+    count = variant_count(settings, mode)
+    if count > MAX_VARIANTS and not force and (mode == "grid" or len(
+            {len(values) for _, values in settings}) == 1):
+        sizes = " x ".join(str(len(values)) for _, values in settings)
+        raise StudyError("set", f"gives {count:,} variants ({sizes}"
+                         f"{'' if mode == 'grid' else ', zipped'}); at most {MAX_VARIANTS:,} "
+                         "unless forced (--force): each variant is a run")
     if mode == "zip":
         length = len(settings[0][1])
         for key, values in settings[1:]:
@@ -236,10 +256,16 @@ def run_variant(document, values, base_dir=None):
     needs the solution.
     """
     t0 = time.perf_counter()
-    problem = build_problem(scene_from_dict(variant_document(document, values), base_dir))
+    record = {"values": values, "worker_peak_rss_mib": peak_rss_mib()}
+    try:
+        problem = build_problem(scene_from_dict(variant_document(document, values), base_dir))
+    except (SceneError, ValueError) as err:   # a combination of values checked one by one
+        return plain(record | {
+            "outcome": "failed", "seconds": time.perf_counter() - t0, "residual": None,
+            "failure": {"step": None, "t": None, "residual": None, "iterations": None,
+                        "message": f"not a valid scene: {err}"}})
     solution, failure = solve_or_failure(problem)
-    record = {"values": values, "seconds": time.perf_counter() - t0,
-              "worker_peak_rss_mib": peak_rss_mib()}
+    record |= {"seconds": time.perf_counter() - t0, "worker_peak_rss_mib": peak_rss_mib()}
     if failure is not None:
         result = failure.result
         return plain(record | {
@@ -285,6 +311,7 @@ def run_row(record, keys):
     for column in MEASURED:
         row[column] = record.get(column)
     row.update(failed_step=failure.get("step"), failed_t=failure.get("t"))
+    row["message"] = failure.get("message")   # printed, not a column of runs.csv
     return row
 
 
@@ -352,19 +379,25 @@ class Sweep(Study):
     The study's identity holds the sha256 of every mesh file a variant
     reads, so a sweep whose mesh file changed is another sweep.
 
+    force : allow more than :data:`MAX_VARIANTS` variants
+
     Raises
     ------
     SceneError for a bad base scene; StudyError naming the setting
-    (``key`` ``"set KEY"``) when a variant is not a valid scene, before
-    anything runs or is written. ``warnings`` lists (variant, warning) of
-    what the theory does not cover.
+    (``key`` ``"set KEY"``) when a value makes the scene invalid, before
+    anything runs or is written. Each value of each setting is checked
+    (applied to the first variant; in zip mode every variant is checked):
+    as many builds as values, not as variants. A combination of valid
+    values that is not a valid scene is found when it runs, and is a failed
+    run saying why. ``warnings`` lists (variant, warning) of what the theory
+    does not cover, for the variants checked.
     """
 
     kind = "parameter sweep"
     runs_folder = "runs"
     compute = _compute_run
 
-    def __init__(self, scene, settings, mode="grid", *, folder, base_dir=None):
+    def __init__(self, scene, settings, mode="grid", *, folder, base_dir=None, force=False):
         super().__init__(folder)
         if base_dir is None and not isinstance(scene, (str, dict)):
             base_dir = Path(scene).absolute().parent
@@ -373,12 +406,24 @@ class Sweep(Study):
         self.base = scene_from_dict(self.source, self.base_dir)
         self.settings = [(key, list(values)) for key, values in settings]
         self.mode = mode
-        self.runs = variants(self.settings, mode)
+        self.runs = variants(self.settings, mode, force)
         self.keys_set = [key for key, _ in self.settings]
         self.warnings = []
-        for index, values in enumerate(self.runs):
-            problem = self._check(values)
+        for index in self.checked():
+            problem = self._check(self.runs[index])
             self.warnings += [(index, str(w)) for w in problem.warnings()]
+
+    def checked(self):
+        """The indices of the variants checked before anything runs: in zip
+        mode all; in grid mode, for each setting, the first variant taking
+        each of its values (the first variant with that key changed), in
+        run order."""
+        if self.mode == "zip":
+            return list(range(len(self.runs)))
+        lengths = [len(values) for _, values in self.settings]
+        strides = [math.prod(lengths[i + 1:]) for i in range(len(lengths))]
+        return sorted({j * stride for length, stride in zip(lengths, strides)
+                       for j in range(length)})
 
     def _check(self, values):
         """The problem of one variant, or StudyError naming the setting at fault."""
