@@ -20,6 +20,22 @@ EXACT = {"dim": 2, "mesh": {"domain": "rectangle", "size": [1.0, 1.0], "cells": 
          "time": {"T": 1.0, "steps": 1}, "exact": {"u": ["x*t", "0"]}}
 
 
+#: a strip on rollers stretched at its right end (prescribed displacements)
+STRETCH = scene_dict({
+    "mesh.cells": [8, 2], "boundary.dirichlet": [], "boundary.contact": [], "contact": DELETE,
+    "boundary.displacement": {"left": ["0", "free"], "bottom": ["free", "0"],
+                              "right": ["0.02*t", "free"]},
+    "loads": DELETE, "time.steps": 4}, BLOCK)
+
+
+def displaced(right=None, left=None):
+    """STRETCH with the right (and left) side's u_x given."""
+    changes = {"boundary.displacement.right": [right, "free"]} if right else {}
+    if left:
+        changes["boundary.displacement.left"] = [left, "free"]
+    return scene_dict(changes, STRETCH)
+
+
 def run(*args):
     return CliRunner().invoke(main, [str(a) for a in args])
 
@@ -47,6 +63,21 @@ def assert_refused(result, out, needle):
      "loads.body[0]: is not finite: nan"),   # a quiet NaN with exit 0 before
     ({"boundary.contact": ["bottom", "left"], "loads.traction": {"right": ["0", "1/(t - 1)"]}},
      BLOCK, "loads.traction.right[1]: is not finite: inf at ("),   # at t = T
+    # prescribed displacements not finite at some t: exit 1 blaming [loads],
+    # after writing the levels before
+    ({}, displaced("1/t"), "boundary.displacement.right[0]: is not finite: inf at (2, 0), "
+                             "t = 0"),
+    ({}, displaced("sqrt(-1 - t)"), "boundary.displacement.right[0]: is not finite: nan"),
+    ({}, displaced(left="log(x)"), "boundary.displacement.left[0]: is not finite: -inf at "
+                                     "(0, 0), t = 0"),
+    ({}, displaced("where(t > 0.5, 0/0, 0.02*t)"),
+     "boundary.displacement.right[0]: is not finite: nan at (2, 0), t = 0.75"),
+    ({}, displaced(float("inf")), "boundary.displacement.right[0]"),
+    ({}, displaced(float("nan")), "boundary.displacement.right[0]"),
+    # a load singular at a level between the 18 sampled ones: exit 0 before
+    ({"loads.body": ["0", "1/(t - 0.01)"], "time.steps": 100}, BLOCK,
+     "loads.body[1]: is not finite: inf at ("),
+    ({"loads.body": ["0", "1/(t - 0.01)"], "time.steps": 100}, BLOCK, "t = 0.01"),
     # MemoryError / ValueError tracebacks
     ({"mesh.cells": [200000, 200000]}, BLOCK, "mesh.cells: gives 4e+10 nodes"),
     ({"time.steps": 1000000000000}, BLOCK, "time.steps: must be an integer in 1..1e+08"),
