@@ -151,3 +151,29 @@ def test_exact_scene_at_the_size_bounds_derives_in_seconds(source):
 def test_exact_scene_within_the_bounds_still_derives_its_loads():
     problem = build_problem(scene_from_dict(scene_dict({"exact.u": ["x**3*t", "0"]}, EXACT)))
     assert solve(problem).success
+
+
+@pytest.mark.parametrize("changes, needle", [
+    # E = 1e308 overflowed the stiffness (exit 1, a NaN step); a sphere of
+    # radius 1e200 an OverflowError traceback
+    ({"material.E": 1e308}, "material.E: gives the tensor lam = 5.77e+307, mu = 3.85e+307, "
+                            "beyond 1e+100, where the stiffness matrix overflows"),
+    ({"material": {"lam": 1e101, "mu": 1.0}}, "material.lam: gives the tensor lam = 1e+101"),
+    ({"contact.foundation": {"shape": "sphere", "point": [1.0, -1e200], "radius": 1e200}},
+     "contact.foundation.radius: 1e+200 is too large (at most 1e+100: the gap squares it)"),
+])
+def test_moduli_and_radii_that_overflow_are_refused(tmp_path, changes, needle):
+    result, out = solve_scene(tmp_path, scene_dict(changes, BLOCK))
+    assert_refused(result, out, needle)
+
+
+def test_moduli_within_the_bound_run():
+    # the same block in units a million times smaller: the same displacements
+    base = scene_dict({"material.E": 1e3, "loads.body": ["0", "-10*t"]}, BLOCK)
+    scaled = scene_dict({"material.E": 1e93, "loads.body": ["0", "-1e91*t"],
+                         "contact.normal": law("compliance", c=1e92)}, BLOCK)
+    base = scene_dict({"contact.normal": law("compliance", c=100.0)}, base)
+    a, b = solve(build_problem(scene_from_dict(base))), solve(build_problem(
+        scene_from_dict(scaled)))
+    assert a.success and b.success
+    assert abs(b.u[-1] - a.u[-1]).max() <= 1e-9 * abs(a.u[-1]).max()

@@ -335,3 +335,12 @@ def test_each_value_is_checked_once_and_a_bad_combination_is_a_failed_row(tmp_pa
     lines = table(result.rows, sweep.keys_set)
     assert lines[3].startswith("run   3: mesh.size=[20.0, 0.5], mesh.cells=[8, 300]: FAILED: "
                                "not a valid scene: mesh.cells: cells of 2.5 x 0.00167")
+
+
+def test_a_value_nested_too_deeply_is_one_line():
+    # --set title=[[[...]]] 3000 deep was a RecursionError (2,999 lines)
+    with pytest.raises(StudyError, match=r"^set title: a value nested 3000 deep \(at most 16 "
+                                         r"levels of brackets\)$"):
+        parse_assignment("title=" + "[" * 3000 + "]" * 3000)
+    assert parse_assignment('title="' + "[" * 40 + '"') == ("title", ["[" * 40])
+    assert parse_assignment("mesh.cells=[[8, 4]]") == ("mesh.cells", [[[8, 4]]])

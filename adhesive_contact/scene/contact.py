@@ -112,6 +112,10 @@ def _point(table, name, dim, nonzero=False):
     return tuple(float(c) for c in value)
 
 
+#: the largest radius of a foundation (its square and products stay finite)
+MAX_LENGTH = 1e100
+
+
 def _read_foundation(table, dim):
     """A FoundationSpec of ``contact.foundation``, or None without the table."""
     if table is None:
@@ -123,6 +127,10 @@ def _read_foundation(table, dim):
         normal = _point(table, "normal", dim, nonzero=True)
     else:
         radius = table.read("radius")
+        if not radius <= MAX_LENGTH:   # the ray-sphere intersection squares it
+            raise SceneError(table.key("radius"), f"{radius:g} is too large (at most "
+                             f"{MAX_LENGTH:g}: the gap squares it); a plane is the limit of "
+                             "a large sphere: use shape = \"plane\"")
     if shape == "cylinder":
         axis = _point(table, "axis", dim, nonzero=True)
     table.finish()

@@ -59,6 +59,8 @@ MEASURED = ("outcome", "failed_step", "failed_t", "residual", "seconds", "newton
             "newton_max", "worker_peak_rss_mib", "beta_min_T", "beta_mean_T",
             "max_un_minus_g", "separated_T", "on_wall_T", "compliance_T", "stick_T",
             "slip_T", "normal_force_T")
+#: the deepest nesting of brackets in a value given to --set
+MAX_VALUE_DEPTH = 16
 _BARE = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
 
@@ -90,6 +92,19 @@ def parse_value(text):
     word that is not TOML (``gauss``) is taken as a string.
 
     Raises ValueError naming the text when it is neither."""
+    depth = level = 0
+    quote = None
+    for char in text:   # before the parser, which recurses per bracket
+        if quote:
+            quote = None if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        else:
+            level += (char in "[{") - (char in "]}")
+            depth = max(depth, level)
+    if depth > MAX_VALUE_DEPTH:
+        raise ValueError(f"a value nested {depth} deep (at most {MAX_VALUE_DEPTH} levels of "
+                         "brackets)")
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
