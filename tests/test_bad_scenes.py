@@ -177,3 +177,12 @@ def test_moduli_within_the_bound_run():
         scene_from_dict(scaled)))
     assert a.success and b.success
     assert abs(b.u[-1] - a.u[-1]).max() <= 1e-9 * abs(a.u[-1]).max()
+
+
+def test_a_contact_side_whose_nodes_are_all_held_is_refused(tmp_path):
+    # one cell wide between two clamped sides: an IndexError in the smallness estimate
+    result, out = solve_scene(tmp_path, scene_dict({
+        "mesh.size": [1.0, 1.0], "mesh.cells": [1, 2],
+        "boundary.dirichlet": ["left", "right"]}, BLOCK))
+    assert_refused(result, out, "boundary.contact: every node of the contact sides (bottom) "
+                   "is on a held side (left, right): nothing on Γ_C is free")

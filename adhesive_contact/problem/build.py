@@ -182,6 +182,11 @@ def contact(scene, mesh, assembly, held, laws, times):
         return Contact(None, empty, empty, None)
     boundary = build_contact_boundary(mesh, held.contact_facets, held.clamped_nodes,
                                       scene.contact.quadrature, scene.contact.order)
+    if boundary.facets.size and not np.setdiff1d(boundary.nodes, held.clamped_nodes).size:
+        raise SceneError("boundary.contact", f"every node of the contact sides "
+                         f"({', '.join(scene.contact_sides)}) is on a held side "
+                         f"({', '.join(scene.held_sides)}): nothing on Γ_C is free; use a "
+                         "finer mesh (mesh.cells) or hold fewer sides")
     assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
     # without friction only u_ν enters the contact terms (the traces of
     # the tangential components vanish on flat facets): solve for it alone

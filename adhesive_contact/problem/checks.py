@@ -232,9 +232,42 @@ _MOTIONS = {2: ("translation along x", "translation along y", "rotation"),
 def check_rigid_motions(mesh, fixed, sides):
     """Refuse held dofs ``fixed`` that leave a rigid motion of the body free:
     the rank of the rigid modes restricted to them must be 3 in 2D (two
-    translations and the rotation) and 6 in 3D."""
-    d = mesh.dim()
-    modes = rigid_modes(mesh.p)
+    translations and the rotation) and 6 in 3D, in each connected part of
+    the mesh (a file mesh may have several: one not held would make the
+    stiffness singular)."""
+    parts = mesh_parts(mesh)
+    if parts.max() > 0:
+        d = mesh.dim()
+        for part in range(parts.max() + 1):
+            nodes = np.flatnonzero(parts == part)
+            held = fixed[np.isin(fixed // d, nodes)]
+            try:
+                _check_part(mesh.p[:, nodes], np.searchsorted(nodes, held // d) * d
+                            + held % d, sides, d)
+            except SceneError as err:
+                centre = mesh.p[:, nodes].mean(axis=1)
+                raise SceneError("boundary", f"the part of the mesh around "
+                                 f"{where(centre)} ({nodes.size} nodes, not connected to "
+                                 f"the rest): {str(err).removeprefix('boundary: ')}") \
+                    from None
+        return
+    _check_part(mesh.p, fixed, sides, mesh.dim())
+
+
+def mesh_parts(mesh):
+    """The connected part of each node (0, 1, ...; nodes of no cell apart)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    t = mesh.t
+    rows = np.repeat(t[:1], t.shape[0] - 1, axis=0).ravel()
+    graph = coo_matrix((np.ones(rows.size), (rows, t[1:].ravel())),
+                       shape=(mesh.p.shape[1],) * 2)
+    return connected_components(graph, directed=False)[1]
+
+
+def _check_part(points, fixed, sides, d):
+    modes = rigid_modes(points)
     held = modes[fixed]
     nmodes = modes.shape[1]
     if fixed.size:
