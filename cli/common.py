@@ -156,7 +156,7 @@ def check_out(out, outputs=()):
 
 def _name_max(path):
     """The longest file name (bytes) the file system of ``path`` allows."""
-    existing = next(p for p in [path, *path.parents] if p.exists())
+    existing = next(p for p in [path, *path.parents] if os.path.exists(p))
     try:
         return os.pathconf(existing, "PC_NAME_MAX")
     except (OSError, ValueError, AttributeError):

@@ -421,3 +421,26 @@ def test_the_lock_file_names_its_owner(tmp_path):
         assert lock.path == tmp_path / "a" / ".b.lock"
         assert lock.path.read_text() == f"{os.getpid()}\n"
     assert not (tmp_path / "a").exists()   # the parent it made is gone again
+
+
+# ---------------------------------------------------------------- --out names
+
+
+@pytest.mark.parametrize("make, needle", [
+    (lambda d: d / ("o" * 300), "is 300 bytes long; at most 239 are allowed here"),
+    (lambda d: (d / "link").symlink_to(d / "nowhere") or d / "link",
+     "is a symbolic link to nothing (or a loop of links)"),
+    (lambda d: ((d / "a").symlink_to(d / "b"), (d / "b").symlink_to(d / "a")) and d / "a",
+     "is a symbolic link to nothing (or a loop of links)"),
+    (lambda d: (d / "link").symlink_to(d / "nowhere") or d / "link" / "out",
+     "is a symbolic link to nothing (or a loop of links)"),
+])
+def test_an_out_that_cannot_be_made_is_refused_before_the_solve(tmp_path, scene, make,
+                                                               needle):
+    # a traceback, or exit 1 after the whole solve
+    out = make(tmp_path)
+    result = runner().invoke(main, ["solve", str(scene), "--out", str(out), "-q"])
+    assert result.exit_code == 2, result.output
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: --out: ")
+    assert needle in result.stderr
+    assert not list(tmp_path.glob("*.lock")) and not list(tmp_path.glob(".*.lock"))
