@@ -506,3 +506,16 @@ def test_a_part_of_the_mesh_held_by_no_side_is_refused(tmp_path):
                                  "foot": lambda x: np.isclose(x[1], 0.0)})
     write_msh(tmp_path / "m.msh", both, ["top", "foot"])
     assert build_problem(scene_from_dict(file_scene(tmp_path / "m.msh"))).free.size
+
+
+@pytest.mark.parametrize("content, needle", [
+    (b"$", "cannot read 'm.msh' as a mesh: meshio gave up on it (meshio: "),   # SystemExit
+    (b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", "'m.msh' has no nodes"),      # IndexError
+])
+def test_a_mesh_file_meshio_gives_up_on_is_one_line(tmp_path, content, needle):
+    # found by tests/test_fuzz_surfaces.py: meshio called sys.exit(1), or read no nodes
+    (tmp_path / "m.msh").write_bytes(content)
+    with pytest.raises(SceneError) as err:
+        build_problem(scene_from_dict(file_scene(tmp_path / "m.msh")))
+    assert "\n" not in str(err.value) and str(err.value).startswith("mesh.file: ")
+    assert needle in str(err.value), str(err.value)

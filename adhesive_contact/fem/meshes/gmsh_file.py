@@ -47,8 +47,9 @@ def _read(path):
     try:
         with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
             return meshio.read(path)
-    except Exception as err:   # meshio raises many kinds on a malformed file
-        reason = " ".join(str(err).split()) or type(err).__name__
+    except (Exception, SystemExit) as err:   # meshio raises many kinds (and may exit)
+        reason = (" ".join(str(err).split()) if not isinstance(err, SystemExit) else
+                  "meshio gave up on it") or type(err).__name__
         said = " ".join(printed.getvalue().split())
         raise MeshFileError(f"cannot read {Path(path).name!r} as a mesh: {reason}"
                             + (f" (meshio: {said[:300]})" if said else "")) from None
@@ -57,6 +58,8 @@ def _read(path):
 def _points(raw, dim, name):
     """The points (dim, n): a 2D file's z column must be zero and is dropped."""
     p = np.asarray(raw.points, dtype=float)
+    if p.ndim != 2 or not p.shape[0]:   # a file cut short may leave none
+        raise MeshFileError(f"{name!r} has no nodes (is the file complete?)")
     if p.shape[1] < dim:
         raise MeshFileError(f"{name!r} has {p.shape[1]}D points, the scene has dim = {dim}")
     if p.shape[1] > dim:
