@@ -49,7 +49,7 @@ def foundation_gap(spec, x, normal):
         n = (n / np.linalg.norm(n))[:, None]
         depth = np.sum((x - point) * n, axis=0)
         toward = np.sum(normal * n, axis=0)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # unselected
             gap = np.where(toward < -1e-12, depth / np.where(toward < 0, -toward, 1.0), np.inf)
         return np.maximum(gap, 0.0), depth
     w, direction = x - point, normal

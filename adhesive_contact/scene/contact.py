@@ -122,6 +122,9 @@ def _read_foundation(table, dim):
         return None
     shape = table.read("shape", dim)
     point = _point(table, "point", dim)
+    if not max(abs(c) for c in point) <= MAX_LENGTH:   # distances to it square it
+        raise SceneError(table.key("point"), f"{show(list(point))} is too far out (each "
+                         f"coordinate at most {MAX_LENGTH:g} in absolute value)")
     normal = axis = radius = None
     if shape == "plane":
         normal = _point(table, "normal", dim, nonzero=True)
