@@ -352,7 +352,8 @@ def test_a_silent_listener_is_one_line_exit_2_within_5_s(scenes, tmp_path):
             started = time.monotonic()
             result = run(command, scenes.block, *args, "--scheduler", listener.address,
                          "--out", tmp_path / command)
-            assert time.monotonic() - started < 5 + 3   # 5 s handshake and the scene's check
+            assert time.monotonic() - started < 5 + 10   # the 5 s handshake, and slack for
+            # the scene's check on a loaded machine (the hang it replaces was >= 60 s)
             assert_one_line_error(result, 2, f"--scheduler {listener.address}: something "
                                   "accepts connections there but does not answer as a dask "
                                   "scheduler within 5 s")

@@ -15,8 +15,6 @@ surface is :data:`EXAMPLES`.
 
 import json
 import math
-import os
-import resource
 import shutil
 import signal
 import socket
@@ -26,6 +24,7 @@ import textwrap
 import threading
 import time
 
+import distributed  # noqa: F401  (imported here, so that no timing below includes it)
 import meshio
 import numpy as np
 import pytest
