@@ -159,7 +159,7 @@ def test_exact_scene_within_the_bounds_still_derives_its_loads():
     ({"material.E": 1e308}, "material.E: gives the tensor lam = 5.77e+307, mu = 3.85e+307, "
                             "beyond 1e+100, where the stiffness matrix overflows"),
     ({"material": {"lam": 1e101, "mu": 1.0}}, "material.lam: gives the tensor lam = 1e+101"),
-    ({"contact.foundation": {"shape": "sphere", "point": [1.0, -1e200], "radius": 1e200}},
+    ({"contact.foundation": {"shape": "sphere", "point": [1.0, -1e99], "radius": 1e200}},
      "contact.foundation.radius: 1e+200 is too large (at most 1e+100: the gap squares it)"),
 ])
 def test_moduli_and_radii_that_overflow_are_refused(tmp_path, changes, needle):
@@ -186,3 +186,10 @@ def test_a_contact_side_whose_nodes_are_all_held_is_refused(tmp_path):
         "boundary.dirichlet": ["left", "right"]}, BLOCK))
     assert_refused(result, out, "boundary.contact: every node of the contact sides (bottom) "
                    "is on a held side (left, right): nothing on Γ_C is free")
+
+
+def test_a_foundation_point_too_far_out_is_refused(tmp_path):
+    result, out = solve_scene(tmp_path, scene_dict({"contact.foundation": {
+        "shape": "sphere", "point": [1.0, -1e200], "radius": 1.0}}, BLOCK))
+    assert_refused(result, out, "contact.foundation.point: [1.0, -1e+200] is too far out "
+                   "(each coordinate at most 1e+100 in absolute value)")
