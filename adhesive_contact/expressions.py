@@ -13,6 +13,7 @@ The validated tree is then evaluated by walking it with NumPy arrays.
 """
 import ast
 import numbers
+import unicodedata
 from typing import Callable, NamedTuple
 
 import numpy as np
@@ -320,6 +321,15 @@ def compile_expression(source):
     if len(source) > MAX_LENGTH:
         raise ExpressionError("expression is too long (more than {} "
                               "characters)".format(MAX_LENGTH))
+    if not source.isascii():
+        # Python reads identifiers in NFKC form: a full-width "ｓｉｎ" would be
+        # taken as sin, while a Cyrillic "х" looks like x and is another name
+        index, char = next((i, c) for i, c in enumerate(source) if not c.isascii())
+        raise ExpressionError(
+            "non-ASCII character {!r} ({}) at position {}: expressions are written in "
+            "ASCII (names such as x, y, z, t, sin, exp; operators + - * / **)".format(
+                char, "U+{:04X} {}".format(ord(char), unicodedata.name(char, "unnamed")),
+                index + 1))
     level = 0
     for char in source:  # protect the parser from deep bracket nesting
         level += (char in '([{') - (char in ')]}')

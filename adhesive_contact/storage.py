@@ -12,6 +12,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -47,9 +48,18 @@ def plain(value):
     return value
 
 
+#: between a file's name and the writer's pid in its temporary name
+TEMPORARY = ".tmp-"
+_TEMPORARY_NAME = re.compile(r"\.(?P<name>.+)\.tmp-(?P<pid>[0-9]+)-[A-Za-z0-9_]+")
+
+
 def write_atomic(path, write, binary=False):
     """Call ``write(file)`` on a temporary file beside ``path``, then rename it
     to ``path`` (replacing it): readers see the old file or the whole new one.
+
+    The temporary file is ``.<name>.tmp-<pid>-XXXXXXXX``, removed when
+    ``write`` raises; one a killed process left is removed by
+    :func:`remove_stale_temporaries`.
 
     Parameters
     ----------
@@ -59,7 +69,7 @@ def write_atomic(path, write, binary=False):
         newline translation)
     """
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.tmp-", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}{TEMPORARY}{os.getpid()}-", dir=path.parent)
     try:
         with (os.fdopen(fd, "wb") if binary else
               os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
@@ -70,6 +80,41 @@ def write_atomic(path, write, binary=False):
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def remove_stale_temporaries(folder):
+    """Remove the temporary files of :func:`write_atomic` in ``folder`` whose
+    writer is no longer alive (a killed process); return their names.
+
+    Only a regular file named ``.<name>.tmp-<pid>-<suffix>`` whose process
+    ``pid`` does not exist goes; a live writer's file, or any other, stays."""
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        match = _TEMPORARY_NAME.fullmatch(entry.name)
+        if match and entry.is_file(follow_symlinks=False) and not pid_alive(int(match["pid"])):
+            with contextlib.suppress(OSError):
+                os.unlink(entry.path)
+                removed.append(entry.name)
+    return removed
+
+
+def pid_alive(pid):
+    """Whether a process ``pid`` exists (one of another user counts; a
+    number no system gives as a pid counts as alive, so that what it names
+    is left alone)."""
+    if pid <= 0 or pid > 1 << 22:
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
 
 
 def dumps(document):

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import click
 
-from .common import load_scene, read_scene, scene_folder
+from .common import CliError, load_scene, read_scene, scene_folder
 
 
 @click.command()
@@ -20,11 +20,27 @@ from .common import load_scene, read_scene, scene_folder
               help="Also print the resolved scene (every default filled in) as JSON.")
 def check(scene, resolved):
     """Validate SCENE (the built-in default if omitted) and print what a run would be."""
+    from adhesive_contact import SceneError, parse_scene
     from adhesive_contact.problem.plausibility import prony_note
-    from adhesive_contact.resources import built_counts, estimate
+    from adhesive_contact.resources import built_counts, estimate, mesh_file_refusal, refusal
     from adhesive_contact.storage import plain
 
     name, text = read_scene(scene)
+    try:   # estimated from the scene alone, before anything is built
+        parsed = parse_scene(text, scene_folder(scene))
+        reason = mesh_file_refusal(parsed)
+        est = None if reason else estimate(parsed)
+        reason = reason or refusal(est)
+    except SceneError as err:
+        raise CliError(str(err), 2) from None
+    if reason:   # building it would take what the machine does not have
+        click.echo(f"{name}: valid scene ({parsed.title}), too large to build here: {reason}")
+        if est is not None:
+            click.echo(f"  estimate: {est.describe()}")
+        click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}")
+        click.echo("  not built: the mesh, contact and smallness figures need the problem; "
+                   "check a coarser scene (mesh.cells, mesh.refine)")
+        return
     parsed, problem = load_scene(text, scene_folder(scene), force=True)
     est = estimate(parsed, counts=built_counts(problem))
     boundary = problem.boundary

@@ -89,8 +89,12 @@ def guard(scene, force=False, out=None, what="the scene"):
     checked), None not to check the disk."""
     if force:
         return
-    from adhesive_contact.resources import estimate, free_disk, refusal
+    from adhesive_contact.resources import estimate, free_disk, mesh_file_refusal, refusal
 
+    reason = mesh_file_refusal(scene)   # before the estimate reads the file
+    if reason:
+        raise CliError(f"mesh.file: {what} is too large for this machine: {reason}; use a "
+                       "smaller mesh, or --force to read it anyway", 2)
     est = estimate(scene)
     reason = refusal(est, disk=None if out is None else free_disk(out))
     if reason:
@@ -99,17 +103,64 @@ def guard(scene, force=False, out=None, what="the scene"):
                        "to run it anyway", 2)
 
 
-def check_out(out):
-    """Refuse (exit 2) an ``--out`` that cannot take the outputs, before the solve.
+def check_out(out, outputs=()):
+    """Refuse (exit 2) an ``--out`` that cannot take the outputs, before the
+    solve, then take its lock (:class:`adhesive_contact.folders.FolderLock`,
+    held until the command ends): a second run into the same folder is
+    refused, exit 2.
 
-    An existing folder is fine: only the run's own files are replaced in it
-    (:func:`~.output.write_outputs`), a user's other files stay."""
+    An existing folder is fine: only the run's own files (``outputs``) are
+    replaced in it, a user's other files stay; one of them that is a
+    folder is refused."""
+    from adhesive_contact.folders import FolderLock, FolderLocked
+
+    text = str(out)
+    if "\0" in text:
+        raise CliError("--out: the path holds a NUL character", 2)
+    out = Path(out)
+    absolute = out.absolute()
+    limit = _name_max(absolute)
+    for part in absolute.parts[1:]:
+        if len(os.fsencode(part)) > limit - 16:   # room for the staging and lock names
+            raise CliError(f"--out: the name {part[:40]!r}... is {len(os.fsencode(part))} "
+                           f"bytes long; at most {limit - 16} are allowed here", 2)
+    for path in [absolute, *absolute.parents]:
+        if path.is_symlink() and not path.exists():
+            raise CliError(f"--out: {str(path)!r} is a symbolic link to nothing (or a loop "
+                           "of links)", 2)
+        if path.exists():
+            break
     if out.exists() and not out.is_dir():
         raise CliError(f"--out: {str(out)!r} exists and is not a folder", 2)
-    existing = next(p for p in [out.absolute(), *out.absolute().parents] if p.exists())
+    existing = next(p for p in [absolute, *absolute.parents] if p.exists())
     if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
         raise CliError(f"--out: {str(out)!r} cannot be written ({str(existing)!r} is not "
                        "a writable folder)", 2)
+    for name in sorted(outputs):
+        if (out / name).is_dir() and not (out / name).is_symlink():
+            raise CliError(f"--out: {str(out / name)!r} is a folder, where the run writes a "
+                           "file; rename it or use another --out", 2)
+    lock = FolderLock(out)
+    try:
+        lock.acquire()
+    except FolderLocked as err:
+        raise CliError(f"--out: {err}; wait for that run to end, or use another --out",
+                       2) from None
+    except OSError as err:
+        raise CliError(f"--out: cannot lock {str(out)!r}: {err.strerror or err}", 2) from None
+    ctx = click.get_current_context(silent=True)
+    if ctx is not None:
+        ctx.call_on_close(lock.release)
+    return lock
+
+
+def _name_max(path):
+    """The longest file name (bytes) the file system of ``path`` allows."""
+    existing = next(p for p in [path, *path.parents] if os.path.exists(p))
+    try:
+        return os.pathconf(existing, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        return 255
 
 
 def open_study(make, out, kind, option=lambda key: f"--{key}"):

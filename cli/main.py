@@ -175,18 +175,18 @@ def solve_command(scene, out, force, quiet):
     from adhesive_contact.problem.warnings import solution_warnings
     from adhesive_contact.scheme import STOPPED
 
-    from .output import staged_output, write_results
+    from .output import OUTPUT_NAMES, holds_complete_run, staged_output, write_results
 
     name, text = read_scene(scene)
     out = Path(out) if out is not None else Path.cwd() / name
     parsed, problem = load_scene(text, scene_folder(scene), force, out)
-    check_out(out)
+    check_out(out, OUTPUT_NAMES)
     if not quiet:
         echo_warnings(problem)
     base = scene_folder(scene)   # summary.json keeps the scene to rebuild the problem from
     source = {"text": text, "folder": None if base is None else str(base.resolve())}
 
-    files, failures = [], []
+    files, failures, kept = [], [], False
     try:
         with staged_output(out) as folder:
             recorder = StreamingRecorder(problem, folder)   # levels to disk as computed
@@ -199,7 +199,9 @@ def solve_command(scene, out, force, quiet):
                     solution = solve(problem, recorder=recorder,
                                      progress=lambda n, N: bar.update(1, recorder.last)
                                      or interrupted())
-                if solution.t.size:   # the levels that converged, partial or not
+                # a partial run never replaces a complete earlier one
+                kept = not solution.success and holds_complete_run(out)
+                if solution.t.size and not kept:   # the levels that converged
                     for warning in solution_warnings(solution):
                         if not quiet:
                             click.echo(f"warning: {warning}", err=True)
@@ -208,18 +210,26 @@ def solve_command(scene, out, force, quiet):
                 recorder.close()
             files = sorted(files + recorder.names) if files else []
     except OSError as err:
-        raise CliError(f"--out: cannot write {str(out)!r}: {err}", 1) from None
+        before = (" (the earlier run there is kept)" if holds_complete_run(out) else "")
+        reason = err.strerror or err
+        raise CliError(f"--out: cannot write {str(out)!r}: {reason}{before}", 1) from None
     for failure in failures:
         if not quiet:
             click.echo(f"warning: {failure}", err=True)
+    not_written = (f"the {solution.t.size} levels done were not written: {out}/ holds a "
+                   "complete earlier run, which is kept (use another --out to keep a "
+                   "partial run)")
     if solution.status == STOPPED:
         raise CliError(f"interrupted after step {solution.steps} (t = {solution.t[-1]:g}); "
-                       f"the {solution.t.size} levels done were written to {out}/ "
-                       "(summary.json: run.partial = true)", 130)
+                       + (not_written if kept else
+                          f"the {solution.t.size} levels done were written to {out}/ "
+                          "(summary.json: run.partial = true)"), 130)
     if not solution.success:
-        kept = (f"The {solution.t.size} levels before it were written to {out}/ "
-                "(summary.json: run.partial = true)." if files else "Nothing was written.")
-        raise CliError(f"{solution.message}. {kept}", 1)
+        written = (f"The {solution.t.size} levels before it were written to {out}/ "
+                   "(summary.json: run.partial = true)." if files else
+                   f"{not_written[0].upper()}{not_written[1:]}." if kept and solution.t.size
+                   else "Nothing was written.")
+        raise CliError(f"{solution.message}. {written}", 1)
 
     mesh, boundary = problem.mesh, problem.boundary
     contact = ("no contact boundary" if boundary is None else

@@ -1,8 +1,9 @@
 """The output folder of ``adhcontact solve`` (docs/outputs.md).
 
-:func:`staged_output` gives a temporary folder that the run writes into
-and then moves into place (:func:`_publish`), so a reader never sees a
-half-written ``DIR`` and a user's own files in ``DIR`` are never touched.
+:func:`staged_output` gives a staging folder that the run writes into
+and then publishes into place (:mod:`adhesive_contact.folders`), so a
+folder that held a whole run holds it or the new whole run whatever
+happens, and a user's own files in ``DIR`` are never touched.
 The run streams its levels there as they are computed
 (:class:`adhesive_contact.io.StreamingRecorder`); :func:`write_results`
 adds the rest:
@@ -19,18 +20,15 @@ adds the rest:
 """
 
 import contextlib
-import glob
-import os
 import resource
-import shutil
-import tempfile
 from pathlib import Path
 
+from adhesive_contact.folders import staged_folder
 from adhesive_contact.io import write_npz, write_xdmf
 from adhesive_contact.resources import estimate
 from adhesive_contact.problem.warnings import solution_warnings
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
-from adhesive_contact.storage import json_number, write_json
+from adhesive_contact.storage import json_number, read_json, write_json
 from adhesive_contact.visuals import PLOT_NAMES, write_plots
 
 from .summary import energy_record, smallness_record, step_records
@@ -117,84 +115,35 @@ OUTPUT_NAMES = frozenset(
      "contact.h5"] + [f"{name}.png" for name in PLOT_NAMES])
 
 
-def _publish(staging, target):
-    """Move the files of folder ``staging`` into ``target``.
-
-    A new ``target`` is ``staging`` renamed, in one step. Into an existing
-    folder the files are moved one by one with :func:`os.replace` (each
-    atomic), ``summary.json`` last and the previous ``summary.json`` removed
-    first, so a folder with a ``summary.json`` always holds one whole run;
-    outputs of a previous run that this run does not write are removed;
-    any other file in ``target`` is left alone."""
-    if not target.exists():
-        os.chmod(staging, 0o755)  # mkdtemp makes it private
-        os.rename(staging, target)
-        return
-    names = {p.name for p in staging.iterdir()}
-    (target / "summary.json").unlink(missing_ok=True)
-    for name in sorted(names - {"summary.json"}) + ["summary.json"]:
-        os.replace(staging / name, target / name)
-    for name in OUTPUT_NAMES - names:
-        (target / name).unlink(missing_ok=True)
-    staging.rmdir()
-
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:       # another user's process: alive
-        return True
-    return True
-
-
-def remove_stale(folder, prefix):
-    """Remove the staging folders ``<prefix><pid>-XXXX`` in ``folder`` left by
-    runs that were killed (their process ``pid`` no longer exists); return
-    their names. A staging folder of a live run, or one named otherwise,
-    stays."""
-    removed = []
-    for path in Path(folder).glob(f"{glob.escape(prefix)}*-*"):
-        pid = path.name[len(prefix):].split("-", 1)[0]
-        if path.is_dir() and pid.isdigit() and not _alive(int(pid)):
-            shutil.rmtree(path, ignore_errors=True)
-            removed.append(path.name)
-    return removed
+def holds_complete_run(out):
+    """Whether folder ``out`` holds a complete run (its summary.json says so)."""
+    document = read_json(Path(out) / "summary.json") if Path(out).is_dir() else None
+    run = document.get("run") if isinstance(document, dict) else None
+    return isinstance(run, dict) and run.get("status") == "complete"
 
 
 @contextlib.contextmanager
 def staged_output(out):
-    """A temporary folder for the outputs of ``out``, published into ``out``
-    when the block ends normally with a ``summary.json`` written
-    (:func:`_publish`) and removed otherwise.
+    """A staging folder for the outputs of ``out``, published into it when
+    the block ends normally with a ``summary.json`` written and removed
+    otherwise (:func:`adhesive_contact.folders.staged_folder`: a folder that
+    held a whole run holds it or the new whole run after any failure, kill
+    or full disk).
 
     Parameters
     ----------
-    out : path of the output folder; its parents are created. In an
-        existing folder only the files of :data:`OUTPUT_NAMES` are replaced;
-        a user's other files stay. The files are staged in a folder named
-        after this process (``<out>.tmp-<pid>-*`` beside a new ``out``,
-        ``.adhcontact.tmp-<pid>-*`` inside an existing one); those of killed
-        runs are removed first (:func:`remove_stale`).
+    out : path of the output folder; its parents are created. Hold its
+        lock (:func:`~.common.check_out`). In an existing folder only the
+        files of :data:`OUTPUT_NAMES` are replaced; a user's other files
+        stay. The staging folder (``<out>.tmp-*`` beside a new ``out``,
+        ``.adhcontact.tmp-*`` inside an existing one) holds the marker file
+        :data:`adhesive_contact.folders.MARKER`; those of killed runs are
+        removed, or their publish finished, first.
     """
     out = Path(out).absolute()
-    if out.is_dir():   # staged inside, so that os.replace stays on one file system
-        remove_stale(out, ".adhcontact.tmp-")
-        tmp = Path(tempfile.mkdtemp(prefix=f".adhcontact.tmp-{os.getpid()}-", dir=out))
-    else:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        remove_stale(out.parent, f"{out.name}.tmp-")
-        tmp = Path(tempfile.mkdtemp(prefix=f"{out.name}.tmp-{os.getpid()}-", dir=out.parent))
-    try:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with staged_folder(out, OUTPUT_NAMES) as tmp:
         yield tmp
-        if (tmp / "summary.json").exists():
-            _publish(tmp, out)
-        else:   # nothing to show: no level was computed
-            shutil.rmtree(tmp)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def write_results(solution, folder, failures=None, source=None):

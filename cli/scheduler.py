@@ -27,6 +27,11 @@ def open_executor(scheduler, jobs):
         raise CliError("--jobs: not with --scheduler (the cluster's workers run the runs; "
                        "start as many as wanted with `dask worker`)", 2)
     from adhesive_contact.studies.executors import ClusterError, dask_executor
+    scheme = scheduler.partition("://")[0] if "://" in scheduler else "tcp"
+    if scheme in ("inproc", "ucx"):   # another process's inproc is unreachable; no ucx here
+        raise CliError(f"--scheduler {scheduler}: the scheme {scheme}:// cannot reach a "
+                       "scheduler from this command; use tcp://host:8786 (or tls://, ws://, "
+                       "wss://)", 2)
     try:
         return dask_executor(scheduler)
     except ClusterError as err:

@@ -51,6 +51,8 @@ def table(rows, keys):
             lines.append(f"run {row['run']:>3}: {settings}: LOST (its worker died; not saved: "
                          "the same command computes it again)")
             continue
+        elif row["failed_step"] is None:   # a combination that is not a valid scene
+            result = f"FAILED: {' '.join(str(row.get('message') or '').split())}"
         else:
             result = (f"FAILED at step {row['failed_step']} (t = {row['failed_t']:g}), "
                       f"residual {row['residual']:.2e}")
@@ -58,7 +60,7 @@ def table(rows, keys):
     return lines
 
 
-def guard_variants(source, settings, grid, force):
+def guard_variants(source, settings, grid, force, base_dir=None):
     """Refuse (exit 2) a sweep with a variant larger than the machine, before
     any variant's mesh is built (:func:`~.common.guard`); ``source`` is the
     decoded scene document."""
@@ -66,7 +68,7 @@ def guard_variants(source, settings, grid, force):
         return
     for values in variants(settings, "grid" if grid else "zip"):
         try:
-            scene = scene_from_dict(variant_document(source, values))
+            scene = scene_from_dict(variant_document(source, values), base_dir)
         except (SceneError, ValueError):
             continue   # the sweep names the setting at fault
         where = ", ".join(f"{k}={toml_value(v)}" for k, v in values.items())
@@ -90,11 +92,14 @@ def guard_variants(source, settings, grid, force):
               help="Output folder. Default: ./<scene file stem>-sweep.")
 @click.option("--force", is_flag=True,
               help="Run even when a variant's estimated memory or time exceeds what the "
-                   "machine has.")
+                   "machine has, or when the settings give more than 1000 variants.")
 def sweep(scene, assignments, grid, jobs, scheduler, out, force):
     """Run SCENE (a TOML file) for every variant given by --set.
 
-    Every variant's scene is checked before anything runs. Writes runs.csv
+    Every value of every --set is checked before anything runs (each
+    applied to the first variant), and every variant's size; at most 1000
+    variants unless --force. A combination of valid values that is not a
+    valid scene is a failed row saying why. Writes runs.csv
     (one row per run: the values set, outcome ok or failed with the step,
     time and residual, wall seconds, Newton iterations total and max per
     step, the worker's peak resident memory so far, β min and mean at T,
@@ -114,8 +119,9 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
     def make():
         settings = [parse_assignment(a) for a in assignments]
         source = study_source(text, scene_folder(scene))
-        guard_variants(source, settings, grid, force)
-        return Sweep(source, settings, "grid" if grid else "zip", folder=out)
+        guard_variants(source, settings, grid, force, scene_folder(scene))
+        return Sweep(source, settings, "grid" if grid else "zip", folder=out,
+                     base_dir=scene_folder(scene), force=force)
 
     study = open_study(make, out, "sweep")
     executor = open_executor(scheduler, jobs)

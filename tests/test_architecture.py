@@ -18,7 +18,7 @@ BASE = {"expressions", "storage", "laws", "step_methods", "linear_solvers"}
 #: allows one module of a package
 ALLOWED = {
     "expressions": set(), "storage": set(), "laws": set(), "step_methods": set(),
-    "linear_solvers": set(),
+    "linear_solvers": set(), "folders": {"storage"},
     "scene": {"expressions", "laws", "step_methods", "linear_solvers", "scheme.bonding",
               "verification.manufactured", "fem.meshes.builtin"},
     "fem": {"expressions", "scene"},
@@ -31,7 +31,7 @@ ALLOWED = {
     "io": {"scene", "problem", "scheme", "postprocess", "storage"},
     "resources": {"scene", "fem", "linear_solvers", "scheme"},
     "studies": BASE | {"scene", "fem", "problem", "scheme", "verification", "postprocess",
-                       "io", "resources", ""},
+                       "io", "resources", "folders", ""},
     "": None,   # adhesive_contact/__init__.py: the public names, from anywhere
 }
 

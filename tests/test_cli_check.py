@@ -120,3 +120,27 @@ def test_check_and_sweep_show_the_stiffness_warning(tmp_path):
     assert swept.exit_code == 0, swept.stderr
     (line,) = [w for w in swept.stderr.splitlines() if "contact.normal.c = 1e+12" in w]
     assert line.startswith("warning: run 0, 1: contact.normal.c = 1e+12")
+
+
+def test_check_of_a_scene_too_large_to_build_prints_the_estimate_without_building(tmp_path):
+    # an 8.1e7-node mesh: check built it and ran out of memory
+    import subprocess
+    import sys
+
+    scene = tmp_path / "huge.toml"
+    scene.write_text(to_toml(scene_dict({"mesh.cells": [18000, 4500], "time.steps": 20})))
+    code = ("import resource, sys; from adhesive_contact_cli.main import main; "
+            "main(['check', sys.argv[1]])")
+    result = subprocess.run([sys.executable, "-c", code, str(scene)], capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("huge: valid scene (untitled), too large to build here: it "
+                               "would need about")
+    assert lines[1].startswith("  estimate: 1.62e+08 dofs")   # 2 x 18001 x 4501
+    assert lines[3].startswith("  not built: ")
+    peak = subprocess.run([sys.executable, "-c", code.replace(
+        "main(['check', sys.argv[1]])", "\ntry:\n    main(['check', sys.argv[1]])\n"
+        "except SystemExit:\n    pass\nprint(resource.getrusage(resource.RUSAGE_SELF)"
+        ".ru_maxrss)"), str(scene)], capture_output=True, text=True, timeout=120)
+    assert int(peak.stdout.splitlines()[-1]) < 500 * 1024   # KiB: nothing was built

@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
-from conftest import assert_one_line_error, law, prony, reference_mesh, runner, scene_dict, to_toml
+from conftest import DELETE, assert_one_line_error, law, prony, reference_mesh, runner, scene_dict, to_toml
 from skfem import Basis, ElementTriP1, ElementVector, Functional
 from skfem.helpers import ddot, sym_grad
 
@@ -519,3 +519,21 @@ def test_a_fine_reference_too_close_is_named():
                         "level: its own error biases the finest errors (use --ref-h 2 or more)"]
     assert trust(document([8e-3, 4e-3, 2e-3], [None, 1.0, 1.0], "h",
                           {"kind": "fine", "ref_h": 2, "ref_k": 0})) == []
+
+
+def test_steps_that_the_relaxation_check_refuses_are_refused_before_the_study(tmp_path):
+    # --steps 1 skipped the check of time.steps = 1 (k = 1 against tau = 0.05):
+    # the study ran and ended with exit 1 after writing its folder
+    scene = tmp_path / "relax.toml"
+    scene.write_text(to_toml(scene_dict({
+        "mesh.cells": [4, 2], "boundary.dirichlet": ["left"], "boundary.contact": [],
+        "loads.body": ["0", "-t"],
+        "memory": {"kernel": "relaxation", "long_term": {"E": 100.0, "nu": 0.3},
+                   "terms": [{"E": 900.0, "tau": 0.05}]},
+        "material": DELETE, "time.steps": 40})))
+    out = tmp_path / "out"
+    result = run(scene, "--param", "h", "--levels", 2, "--steps", 1,
+                 "--out", out)
+    assert_one_line_error(result, 2, "--steps: the time step k = 1 is too large for the "
+                          "relaxation time tau = 0.05")
+    assert not out.exists()

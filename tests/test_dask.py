@@ -9,6 +9,8 @@ import csv
 import json
 import os
 import socket
+import threading
+import time
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -283,3 +285,88 @@ def test_help_documents_scheduler():
         text = " ".join(result.stdout.split())
         assert "--scheduler ADDRESS" in text
         assert "dask.distributed scheduler" in text and "tcp://host:8786" in text
+
+
+# ---------------------------------------------------------------- listeners that are not schedulers
+
+
+class Listener:
+    """A loopback TCP listener the test starts and stops: ``silent`` accepts
+    and says nothing, ``http`` reads a request and waits (as an HTTP server
+    does before it answers), ``garbage`` sends bytes that are no handshake,
+    ``closes`` accepts and closes at once."""
+
+    def __init__(self, kind):
+        self.kind, self.sockets = kind, []
+        self.server = socket.socket()
+        self.server.bind(("127.0.0.1", 0))
+        self.server.listen(8)
+        self.address = f"tcp://127.0.0.1:{self.server.getsockname()[1]}"
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self):
+        while True:
+            try:
+                conn, _ = self.server.accept()
+            except OSError:
+                return
+            self.sockets.append(conn)
+            if self.kind == "garbage":
+                conn.sendall(b"\xff" * 64 + b"HTTP/1.1 400 Bad Request\r\n\r\n")
+            elif self.kind == "closes":
+                conn.close()
+
+    def close(self):
+        self.server.close()
+        for conn in self.sockets:
+            conn.close()
+
+
+@pytest.mark.parametrize("kind, needle", [
+    ("silent", "something accepts connections there but does not answer as a dask "
+               "scheduler within 1 s"),
+    ("http", "something accepts connections there but does not answer as a dask "
+             "scheduler within 1 s"),
+    ("garbage", "something answers there, but not a dask scheduler (its first message is "
+                "not a handshake)"),
+    ("closes", "something accepts connections there but does not answer as a dask "
+               "scheduler within 1 s"),
+])
+def test_a_listener_that_is_not_a_scheduler_is_refused_within_the_timeout(kind, needle):
+    listener = Listener(kind)
+    try:
+        started = time.monotonic()
+        with pytest.raises(ClusterError) as info:
+            dask_executor(listener.address, timeout=1.0)
+        assert time.monotonic() - started < 1.5   # the handshake's bound, whatever answers
+        assert info.value.message == needle
+    finally:
+        listener.close()
+
+
+def test_a_silent_listener_is_one_line_exit_2_within_5_s(scenes, tmp_path):
+    listener = Listener("silent")
+    try:
+        for command, args in (("sweep", GRID), ("converge", ("--param", "k", "--levels", 2))):
+            started = time.monotonic()
+            result = run(command, scenes.block, *args, "--scheduler", listener.address,
+                         "--out", tmp_path / command)
+            assert time.monotonic() - started < 5 + 10   # the 5 s handshake, and slack for
+            # the scene's check on a loaded machine (the hang it replaces was >= 60 s)
+            assert_one_line_error(result, 2, f"--scheduler {listener.address}: something "
+                                  "accepts connections there but does not answer as a dask "
+                                  "scheduler within 5 s")
+            assert not (tmp_path / command).exists()
+    finally:
+        listener.close()
+
+
+@pytest.mark.parametrize("address", ["inproc://127.0.0.1/1/1", "ucx://127.0.0.1:8786"])
+def test_a_scheme_the_command_cannot_reach_is_one_line_exit_2(scenes, tmp_path, address):
+    started = time.monotonic()
+    result = run("sweep", scenes.block, *GRID, "--scheduler", address, "--out", tmp_path / "o")
+    assert time.monotonic() - started < 5
+    assert_one_line_error(result, 2, f"--scheduler {address}: the scheme "
+                          f"{address.split(':')[0]}:// cannot reach a scheduler from this "
+                          "command")

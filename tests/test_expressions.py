@@ -266,3 +266,18 @@ def test_a_flat_sum_is_not_nested_and_evaluates_in_order():
         expected = expected + i * x
     assert compile_expression("+".join(terms))(x).tolist() == expected.tolist()
     assert compile_expression("-".join(["x"] * 900))(x).tolist() == (-898 * x).tolist()
+
+
+@pytest.mark.parametrize("source, char, position", [
+    ("ｘ + 1", "'ｘ' (U+FF58 FULLWIDTH LATIN SMALL LETTER X)", 1),   # NFKC: x
+    ("2*ｓｉｎ(x)", "'ｓ' (U+FF53 FULLWIDTH LATIN SMALL LETTER S)", 3),   # NFKC: sin
+    ("х*2", "'х' (U+0445 CYRILLIC SMALL LETTER HA)", 1),   # looks like x
+    ("1 − t", "'−' (U+2212 MINUS SIGN)", 3),
+])
+def test_non_ascii_names_are_refused_and_said_to_be(source, char, position):
+    # Python normalised ｘ to x and ｓｉｎ to sin; х was "name 'х' is not allowed"
+    with pytest.raises(ExpressionError) as info:
+        compile_expression(source)
+    assert str(info.value) == (f"non-ASCII character {char} at position {position}: "
+                               "expressions are written in ASCII (names such as x, y, z, t, "
+                               "sin, exp; operators + - * / **)")

@@ -5,6 +5,10 @@ The committed meshes are made by studies/meshes/make_meshes.py (gmsh); the
 tests also write small meshes with meshio to check what the reader refuses.
 """
 
+import json
+import os
+import subprocess
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -272,6 +276,30 @@ def test_foundation_normal_and_gap_at_the_closest_point():
     assert g.min() == pytest.approx(0.1, abs=2e-3)
 
 
+@pytest.mark.parametrize("key, vector, dim", [
+    ("normal", [0.0, 5e-324], 2), ("normal", [1e-300, 1e308], 2), ("normal", [0.0, 1e-170], 2),
+    ("axis", [0.0, 0.0, 5e-324], 3)])
+def test_a_foundation_direction_whose_length_under_or_overflows_is_refused(key, vector, dim):
+    # |v|² is 0 or inf in floating point: v/|v| removed the wall without a word
+    foundation = ({"point": [0.0, -0.1], "normal": vector} if key == "normal" else
+                  {"shape": "cylinder", "point": [0.0, -2.0, 0.0], "axis": vector,
+                   "radius": 1.9})
+    scene = file_scene(HALF_DISC if dim == 2 else CYLINDER, {
+        "contact.normal": law("compliance", c=1e3), "contact.foundation": foundation},
+        dim=dim)
+    with pytest.raises(SceneError, match=rf"^contact\.foundation\.{key}: .* has a length "
+                                         r"whose square (under|over)flows in floating "
+                                         r"point; give the direction with components of "
+                                         r"moderate size, e\.g\. \[0, 1\]$"):
+        scene_from_dict(scene)
+    # the same direction scaled to moderate size is a wall
+    scale = max(abs(c) for c in vector)
+    moderate = [c / scale for c in vector]
+    scene["contact"]["foundation"][key] = moderate
+    problem = build_problem(scene_from_dict(scene))
+    assert np.isfinite(problem.gap[0]).any()
+
+
 def test_cylinder_foundation_in_3d():
     p = build_problem(scene_from_dict(file_scene(CYLINDER, {
         "contact.normal": law("compliance", c=1e3), "contact.foundation": {
@@ -401,3 +429,147 @@ def test_builtin_sides_and_facets_equal_scikit_fems_own(spec):
     for name, facets in own.boundaries.items():
         assert facets.size > 0
         np.testing.assert_array_equal(mesh.boundaries[name], facets)
+
+
+# ---------------------------------------------------------------- mesh paths that are not files
+
+
+@pytest.mark.parametrize("make, needle", [
+    (lambda d: os.mkfifo(d / "m.msh") or "m.msh", "is a named pipe (FIFO), not a regular file"),
+    (lambda d: "/dev/zero", "'/dev/zero' is a device, not a regular file"),
+    (lambda d: (d / "m.msh").mkdir() or "m.msh", "is a folder, not a regular file"),
+    (lambda d: "~nosuchuser12345/m.msh", "no such user's home folder (~nosuchuser12345)"),
+    (lambda d: "m\0.msh", "mesh.file: the path holds a NUL character"),
+])
+def test_a_mesh_path_that_is_not_a_regular_file_is_one_line_exit_2(tmp_path, make, needle):
+    # a FIFO blocked the read for ever, /dev/zero ran out of memory, the rest
+    # were tracebacks; in a child, so that a hang fails the test
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(file_scene(make(tmp_path))))
+    result = subprocess.run([sys.executable, "-c", "from adhesive_contact_cli.main import "
+                             "main; main()", "solve", str(scene), "--out", str(tmp_path / "o")],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: mesh.file: ") and needle in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_load_solution_of_a_scene_text_naming_a_fifo_is_refused(tmp_path):
+    from adhesive_contact import OutputFolderError, load_solution
+
+    (tmp_path / "m.msh").write_bytes(HALF_DISC.read_bytes())
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(file_scene("m.msh")))
+    out = tmp_path / "out"
+    assert CliRunner().invoke(main, ["solve", str(scene), "--out", str(out)]).exit_code == 0
+    os.mkfifo(tmp_path / "pipe.msh")
+    summary = json.loads((out / "summary.json").read_text())
+    summary["source"]["text"] = summary["source"]["text"].replace("m.msh", "pipe.msh")
+    (out / "summary.json").write_text(json.dumps(summary))
+    with pytest.raises(OutputFolderError, match="its scene cannot be built here: mesh.file: "
+                       ".*pipe.msh' is a named pipe"):
+        load_solution(out)
+
+
+# ---------------------------------------------------------------- defective mesh files
+
+
+def strip_mesh():
+    from skfem import MeshTri
+
+    mesh = MeshTri.init_tensor(np.linspace(0, 2, 5), np.linspace(0, 1, 3))
+    return mesh.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0),
+                                 "foot": lambda x: np.isclose(x[1], 0.0)})
+
+
+def write_defective(path, defect):
+    """A 2 x 1 strip of 16 triangles as gmsh 2.2, with one defect."""
+    mesh = strip_mesh()
+    if defect == "nan":
+        mesh = type(mesh)(np.where(np.arange(mesh.p.shape[1]) == 4, np.nan, mesh.p), mesh.t)
+        mesh = mesh.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0),
+                                     "foot": lambda x: x[1] < 1e-9})
+    elif defect in ("tiny", "huge"):
+        scale = 1e-300 if defect == "tiny" else 1e300
+        mesh = type(mesh)(mesh.p * scale, mesh.t).with_boundaries(
+            {"top": lambda x: np.isclose(x[1], scale), "foot": lambda x: x[1] == 0})
+    cells = None
+    if defect == "collapsed":   # a sliver on the three nodes of the left side, x = 0
+        cells = np.vstack([mesh.t.T, [[0, 1, 2]]])
+    write_msh(path, mesh, ["top", "foot"], cells=cells)
+    if defect == "empty foot":
+        text = path.read_text().replace('1 2 "foot"', '1 9 "foot"')
+        path.write_text(text)
+
+
+@pytest.mark.parametrize("defect, needle", [
+    ("nan", "has a node that is not finite: (nan, nan)"),
+    ("tiny", "spans 2e-300; a mesh must span between 1e-100 and 1e+100"),
+    ("huge", "spans 2e+300; a mesh must span between 1e-100 and 1e+100"),
+    ("collapsed", "has 1 collapsed triangle cells (zero area), the first with corners (0, 0); "
+                  "(0, 0.5); (0, 1)"),
+    ("empty foot", "boundary.contact[0]: the mesh's boundary group 'foot' is empty"),
+])
+def test_a_defective_mesh_file_is_one_line_naming_the_file_and_the_defect(tmp_path, defect,
+                                                                           needle):
+    # tracebacks (SVD, a singular factor, eigh) or a run without contact
+    write_defective(tmp_path / "m.msh", defect)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(file_scene("m.msh", {"contact.normal": law("compliance",
+                                                                        c=100.0)})))
+    result = CliRunner().invoke(main, ["solve", str(scene), "--out", str(tmp_path / "o")])
+    lines = result.stderr.splitlines()
+    assert result.exit_code == 2, result.stderr
+    assert len(lines) == 1 and needle in lines[0], lines
+    assert "'m.msh'" in lines[0] or "boundary." in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_mesh_file_cut_short_is_one_line_without_meshios_warnings(tmp_path):
+    (tmp_path / "m.msh").write_bytes((MESHES / "half_disc_v22.msh").read_bytes()[:3000])
+    scene = tmp_path / "scene.toml"
+    scene.write_text(to_toml(file_scene("m.msh")))
+    result = subprocess.run([sys.executable, "-c", "from adhesive_contact_cli.main import "
+                             "main; main()", "solve", str(scene), "--out", str(tmp_path / "o")],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith(
+        "error: mesh.file: cannot read 'm.msh' as a mesh: "), result.stderr
+
+
+def test_a_part_of_the_mesh_held_by_no_side_is_refused(tmp_path):
+    # two strips in one file, only the first hung from its top: a singular factor
+    from skfem import MeshTri
+
+    a = strip_mesh()
+    both = MeshTri(np.hstack([a.p, a.p + np.array([[3.0], [0.0]])]),
+                   np.hstack([a.t, a.t + a.p.shape[1]]))
+    both = both.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0) & (x[0] < 2.5),
+                                 "foot": lambda x: np.isclose(x[1], 0.0)})
+    write_msh(tmp_path / "m.msh", both, ["top", "foot"])
+    scene = scene_from_dict(file_scene(tmp_path / "m.msh"))
+    with pytest.raises(SceneError, match=r"^boundary: the part of the mesh around \(4, 0\.5\) "
+                                         r"\(15 nodes, not connected to the rest\): the held "
+                                         r"sides \(top\) leave the body free to move rigidly "
+                                         r"\(translation along x, translation along y, "
+                                         r"rotation\)"):
+        build_problem(scene)
+    # each strip hung from its top: both held, the problem builds
+    both = both.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0),
+                                 "foot": lambda x: np.isclose(x[1], 0.0)})
+    write_msh(tmp_path / "m.msh", both, ["top", "foot"])
+    assert build_problem(scene_from_dict(file_scene(tmp_path / "m.msh"))).free.size
+
+
+@pytest.mark.parametrize("content, needle", [
+    (b"$", "cannot read 'm.msh' as a mesh: meshio gave up on it (meshio: "),   # SystemExit
+    (b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", "'m.msh' has no nodes"),      # IndexError
+])
+def test_a_mesh_file_meshio_gives_up_on_is_one_line(tmp_path, content, needle):
+    # found by tests/test_fuzz_surfaces.py: meshio called sys.exit(1), or read no nodes
+    (tmp_path / "m.msh").write_bytes(content)
+    with pytest.raises(SceneError) as err:
+        build_problem(scene_from_dict(file_scene(tmp_path / "m.msh")))
+    assert "\n" not in str(err.value) and str(err.value).startswith("mesh.file: ")
+    assert needle in str(err.value), str(err.value)

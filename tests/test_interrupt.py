@@ -13,10 +13,9 @@ import time
 
 import numpy as np
 import pytest
-from adhesive_contact_cli import output as output_module
 from adhesive_contact_cli.main import main
 from click.testing import CliRunner
-from conftest import COMPLIANT_BLOCK, invoke, law, prony, scene_dict, solve_scene, to_toml
+from conftest import COMPLIANT_BLOCK, invoke, law, prony, scene_dict, to_toml
 
 
 # a small block pushed onto a compliant foundation: a few ms per step, so
@@ -133,30 +132,6 @@ def test_ctrl_c_stops_a_sweep_which_resumes_from_the_runs_done(tmp_path, jobs):
     assert f"{6 - done} computed now, {done} loaded" in result.stdout
 
 
-# ----------------------------------------------------------------
-# Staging folders of killed runs are removed by the next run.
-
-
-def dead_pid():
-    """The pid of a process that has ended."""
-    child = subprocess.Popen([sys.executable, "-c", "pass"])
-    child.wait()
-    return child.pid
-
-
-def test_staging_folders_of_killed_runs_are_removed(tmp_path):
-    stale = tmp_path / f"out.tmp-{dead_pid()}-abcd"
-    live = tmp_path / f"out.tmp-{os.getpid()}-efgh"
-    other = tmp_path / "out.tmp-notes"
-    for folder in (stale, live, other):
-        folder.mkdir()
-        (folder / "summary.json").write_text("{")
-    result, out = solve_scene(tmp_path, COMPLIANT_BLOCK)
-    assert result.exit_code == 0, result.stderr
-    assert not stale.exists() and live.exists() and other.exists()
-    inside = out / f".adhcontact.tmp-{dead_pid()}-ijkl"
-    inside.mkdir()
-    assert output_module.remove_stale(out, ".adhcontact.tmp-") == [inside.name]
 
 
 # ----------------------------------------------------------------

@@ -157,8 +157,45 @@ def edit_summary(path, change):
     path.write_text(json.dumps(document))
 
 
+def replace_key(path, key, value):
+    with np.load(path) as data:
+        arrays = {name: data[name] for name in data.files}
+    arrays[key] = value(arrays[key])
+    np.savez_compressed(path, **arrays)
+
+
+def claim_entries(path, key, count):
+    """Replace ``key`` by an array whose header claims ``count`` entries (the
+    data holds 8 bytes): reading it would allocate 8·count bytes."""
+    with np.load(path) as data:
+        arrays = {name: data[name] for name in data.files if name != key}
+    np.savez_compressed(path, **arrays)
+    with zipfile.ZipFile(path, "a") as archive, archive.open(f"{key}.npy", "w") as f:
+        np.lib.format.write_array_header_2_0(f, {"descr": "<f8", "fortran_order": False,
+                                                 "shape": (count,)})
+        f.write(b"\0" * 8)
+
+
 @pytest.mark.parametrize("change, file, needle", [
     (lambda f: (f / "summary.json").unlink(), "summary.json", "no such file"),
+    # tampered arrays: accepted, then a failure (or a traceback) in use;
+    # a header of 1e11 entries tried to allocate 745 GiB
+    (lambda f: replace_key(f / "solution.npz", "u", lambda u: u[:, :, :1]), "solution.npz",
+     "holds 'u' of shape (4, 27, 1), not (4, 27, 2)"),
+    (lambda f: replace_key(f / "solution.npz", "u", lambda u: u.astype(str)), "solution.npz",
+     "holds 'u' of dtype <U"),
+    (lambda f: replace_key(f / "solution.npz", "beta", lambda b: b[:, :-1]), "solution.npz",
+     "holds 'beta' of shape (4, 7), not (4, 8)"),
+    (lambda f: replace_key(f / "solution.npz", "contact_force", lambda c: c[:2]),
+     "solution.npz", "holds 'contact_force' of shape (2, 9, 2), not (4, 9, 2)"),
+    (lambda f: replace_key(f / "solution.npz", "on_wall", lambda w: w.astype(float)),
+     "solution.npz", "holds 'on_wall' of dtype float64, not bool"),
+    (lambda f: claim_entries(f / "solution.npz", "u", 10**11), "solution.npz",
+     "holds 'u' of shape (100000000000,), not (4, 27, 2)"),
+    (lambda f: (f / "summary.json").write_text("[" * 100000 + "]" * 100000),
+     "summary.json", "is nested too deeply to be a summary.json"),
+    (lambda f: edit_summary(f / "summary.json", lambda d: d["run"].update(levels="4")),
+     "summary.json", "its run record is damaged (run.status, run.levels)"),
     (lambda f: (f / "summary.json").write_text("{\"schema\": 1, "), "summary.json",
      "not valid JSON"),
     (lambda f: edit_summary(f / "summary.json", lambda d: d.update(schema=2)),

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import scene_dict
 
-from adhesive_contact import build_problem, parse_scene, scene_from_dict, solve
+from adhesive_contact import SceneError, build_problem, parse_scene, scene_from_dict, solve
 from adhesive_contact.verification.levels import with_discretisation
 from adhesive_contact.scheme import STEP_FAILED, InvalidState
 from adhesive_contact.scheme.level_checks import check_level
@@ -64,13 +64,18 @@ def test_within_the_bound_the_same_scene_runs():
     assert solve(debonding(50)).success
 
 
-def test_non_finite_load_between_the_checked_times_stops_at_its_step():
+def test_non_finite_load_between_the_checked_times_stops_at_its_step(monkeypatch):
     # no contact boundary: before, a load 0/0 gave exit 0 and an all-NaN u.
-    # Validation checks the loads at t = 0, T and 16 levels between (a 0/0
-    # is refused there, test_values.py); a load that is infinite at t_1 =
-    # 0.025 only, a level it does not sample, is caught by the scheme
+    # Validation checks the loads on every level of the run: a load infinite
+    # at t_1 = 0.025 only is refused there; without that check (a load no
+    # check could see) the scheme stops at the level
     scene = scene_dict({"boundary": {"dirichlet": ["left"], "contact": []},
                         "loads.body": ["1/(t - 0.025)", "0"], "time.steps": 40})
+    with pytest.raises(SceneError, match=r"^loads\.body\[0\]: is not finite: inf at "
+                                         r"\(0, 0\), t = 0\.025$"):
+        build_problem(scene_from_dict(scene))
+    import adhesive_contact.problem.build as build
+    monkeypatch.setattr(build, "check_loads", lambda *args: None)
     sol = solve(build_problem(scene_from_dict(scene)))
     assert isinstance(sol.failure, InvalidState) and sol.failure.n == 1
     assert "the load (body force" in str(sol.failure) and sol.t.size == 1

@@ -3,11 +3,13 @@ settings parsed as TOML values, every variant validated before anything
 runs, failed runs as rows, runs.csv against direct solves, resume."""
 
 import csv
+import time
 import shutil
 
 import numpy as np
 import pytest
 from adhesive_contact_cli.main import main
+from adhesive_contact_cli.sweep import table
 from conftest import assert_one_line_error, runner, scene_dict, to_toml, wall_block
 
 import adhesive_contact.studies.sweep as sweep_module
@@ -64,9 +66,9 @@ def counting(monkeypatch):
     calls = []
     real = sweep_module.run_variant
 
-    def run_variant(document, values):
+    def run_variant(document, values, base_dir=None):
         calls.append(dict(values))
-        return real(document, values)
+        return real(document, values, base_dir)
 
     monkeypatch.setattr(sweep_module, "run_variant", run_variant)
     return calls
@@ -260,3 +262,117 @@ def test_sweep_reports_energies_and_debonded_area(tmp_path):
     header = (tmp_path / "out" / "runs.csv").read_text().splitlines()[0].split(",")
     assert {"reaction_left_x_peak", "reaction_right_y_T", "work_T", "dissipated_T",
             "balance_T", "damage_T"} <= set(header)
+
+
+# ---------------------------------------------------------------- a swept mesh file
+
+
+def write_rectangle_msh(path, cells):
+    """A 2 × 0.5 rectangle of ``cells`` triangles per side as gmsh 2.2, with
+    the named sides top and foot (the bottom)."""
+    import meshio
+    from skfem import MeshTri
+
+    mesh = MeshTri.init_tensor(np.linspace(0, 2, 2 * cells + 1),
+                               np.linspace(0, 0.5, cells // 2 + 1))
+    mesh = mesh.with_boundaries({"top": lambda x: np.isclose(x[1], 0.5),
+                                 "foot": lambda x: np.isclose(x[1], 0.0)})
+    blocks = [("line", mesh.facets[:, mesh.boundaries[s]].T) for s in ("top", "foot")]
+    blocks.append(("triangle", mesh.t.T))
+    tags = [np.full(len(b[1]), i + 1) for i, b in enumerate(blocks)]
+    meshio.write(path, meshio.Mesh(
+        np.column_stack([mesh.p.T, np.zeros(mesh.p.shape[1])]), blocks,
+        cell_data={"gmsh:physical": tags, "gmsh:geometrical": tags},
+        field_data={"top": np.array([1, 1]), "foot": np.array([2, 1]),
+                    "body": np.array([3, 2])}), file_format="gmsh22", binary=False)
+
+
+FILE_SCENE = scene_dict({
+    "mesh": {"domain": "file", "file": "m1.msh"},
+    "boundary": {"dirichlet": ["top"], "contact": ["foot"]},
+    "loads": {"body": ["0", "-10*t"]},
+    "contact": {"normal": {"law": "compliance", "c": 100.0}}, "time.steps": 2})
+
+
+def test_a_swept_mesh_file_is_the_scene_folders_and_its_content_is_the_sweeps(
+        tmp_path, monkeypatch):
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    write_rectangle_msh(scenes / "m1.msh", 4)
+    write_rectangle_msh(scenes / "m2.msh", 8)
+    write_rectangle_msh(tmp_path / "m2.msh", 16)   # a decoy in the working directory
+    scene = scenes / "scene.toml"
+    scene.write_text(to_toml(FILE_SCENE))
+    monkeypatch.chdir(tmp_path)
+    args = [scene, "--set", 'mesh.file="m2.msh"', "--out", tmp_path / "out"]
+    result = run(*args)
+    assert result.exit_code == 0, result.output
+    [row] = read_rows(tmp_path / "out" / "runs.csv")
+
+    def force(folder):   # the scene's own m2.msh, read by the library from its file
+        variant = folder / "variant.toml"
+        variant.write_text(to_toml(scene_dict({"mesh.file": "m2.msh"}, FILE_SCENE)))
+        from adhesive_contact import load_scene
+        return solve(build_problem(load_scene(variant))).total_normal_force()[-1]
+
+    assert float(row["normal_force_T"]) == pytest.approx(force(scenes), rel=1e-12)
+    assert abs(float(row["normal_force_T"]) - force(tmp_path)) > 1e-6 * abs(force(tmp_path))
+    # the mesh file changes: the folder holds another sweep, nothing is reused
+    write_rectangle_msh(scenes / "m2.msh", 6)
+    result = run(*args)
+    assert_one_line_error(result, 2, "holds a different sweep (files")
+
+
+# ---------------------------------------------------------------- many variants
+
+
+@pytest.mark.parametrize("sets, count, sizes", [
+    (("contact.normal.c=" + ",".join(str(100 + i) for i in range(100)),
+      "solver.max_iter=" + ",".join(str(10 + i) for i in range(100))), "10,000", "100 x 100"),
+    (("contact.normal.c=" + ",".join(str(100 + i) for i in range(1000)),
+      "solver.max_iter=" + ",".join(str(10 + i) for i in range(1000))), "1,000,000",
+     "1000 x 1000"),
+])
+def test_more_variants_than_the_maximum_are_refused_at_once(scene_file, tmp_path, counting,
+                                                           sets, count, sizes):
+    # every variant was built and validated first: no answer for 10^4 or 10^6
+    started = time.perf_counter()
+    result = run(scene_file, *[x for s in sets for x in ("--set", s)], "--out", tmp_path / "o")
+    assert time.perf_counter() - started < 20
+    assert_one_line_error(result, 2, f"--set: gives {count} variants ({sizes}); at most "
+                          "1,000 unless forced (--force): each variant is a run")
+    assert counting == [] and not (tmp_path / "o").exists()
+
+
+def test_each_value_is_checked_once_and_a_bad_combination_is_a_failed_row(tmp_path,
+                                                                         monkeypatch):
+    built = []
+    real = sweep_module.build_problem
+    monkeypatch.setattr(sweep_module, "build_problem",
+                        lambda scene: built.append(scene) or real(scene))
+    settings = [("contact.normal.c", [1e3, 2e3, 3e3]), ("solver.max_iter", [20, 30, 40, 50])]
+    sweep = Sweep(SCENE, settings, folder=tmp_path / "out")
+    assert sweep.checked() == [0, 1, 2, 3, 4, 8]   # 3 + 4 - 1 builds, not 12
+    assert len(built) == 6
+    # values valid one by one, not together: 20 x 0.5 in 8 x 300 cells are
+    # 2.5 x 0.00167, elongated 1500:1 (at most 1000:1)
+    combo = [("mesh.size", [[2.0, 0.5], [20.0, 0.5]]), ("mesh.cells", [[8, 4], [8, 300]])]
+    sweep = Sweep(SCENE, combo, folder=tmp_path / "combo")
+    assert sweep.checked() == [0, 1, 2]
+    result = sweep.run()
+    assert [r["outcome"] for r in result.records] == ["ok", "ok", "ok", "failed"]
+    failure = result.records[3]["failure"]
+    assert failure["step"] is None and failure["message"].startswith(
+        "not a valid scene: mesh.cells: cells of 2.5 x 0.00167 are elongated more than 1000:1")
+    lines = table(result.rows, sweep.keys_set)
+    assert lines[3].startswith("run   3: mesh.size=[20.0, 0.5], mesh.cells=[8, 300]: FAILED: "
+                               "not a valid scene: mesh.cells: cells of 2.5 x 0.00167")
+
+
+def test_a_value_nested_too_deeply_is_one_line():
+    # --set title=[[[...]]] 3000 deep was a RecursionError (2,999 lines)
+    with pytest.raises(StudyError, match=r"^set title: a value nested 3000 deep \(at most 16 "
+                                         r"levels of brackets\)$"):
+        parse_assignment("title=" + "[" * 3000 + "]" * 3000)
+    assert parse_assignment('title="' + "[" * 40 + '"') == ("title", ["[" * 40])
+    assert parse_assignment("mesh.cells=[[8, 4]]") == ("mesh.cells", [[[8, 4]]])

@@ -102,7 +102,7 @@ def foundation_gap(spec, x, normal):
     depth = signed_distance(spec, x)
     if spec.shape == "plane":
         toward = np.sum(normal * _unit(spec.normal), axis=0)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # unselected
             gap = np.where(toward < -1e-12, depth / np.where(toward < 0, -toward, 1.0), np.inf)
         return np.maximum(gap, 0.0), depth
     direction = normal

@@ -46,6 +46,9 @@ def read_summary(path):
     except json.JSONDecodeError as err:
         raise OutputFolderError(path, f"not valid JSON ({err}): the file is damaged; run "
                                 "the scene again") from None
+    except RecursionError:
+        raise OutputFolderError(path, "is nested too deeply to be a summary.json: the file "
+                                "is damaged; run the scene again") from None
     if not isinstance(document, dict) or document.get("schema") != SCHEMA:
         found = document.get("schema") if isinstance(document, dict) else None
         raise OutputFolderError(path, f"has schema {found!r}; this version reads schema "
@@ -56,14 +59,52 @@ def read_summary(path):
     return document
 
 
-def read_arrays(path, names):
-    """{name: array} of ``names`` from the npz file ``path``."""
+#: the kinds of numpy dtype each kind of array may have ("f" floats, "b"
+#: booleans, "i" integers; integers may stand for floats)
+KINDS = {"f": "fiu", "b": "b", "i": "iu"}
+
+
+def array_headers(path, names):
+    """{name: (shape, dtype)} of the arrays ``names`` in the npz file
+    ``path``, read from their headers alone (nothing is allocated)."""
+    headers = {}
+    with zipfile.ZipFile(path) as archive:
+        members = set(archive.namelist())
+        for name in names:
+            if f"{name}.npy" not in members:
+                continue
+            with archive.open(f"{name}.npy") as f:
+                version = np.lib.format.read_magic(f)
+                read = (np.lib.format.read_array_header_1_0 if version == (1, 0) else
+                        np.lib.format.read_array_header_2_0)
+                shape, _, dtype = read(f)
+            headers[name] = (tuple(shape), dtype)
+    return headers
+
+
+def read_arrays(path, names, expected=None):
+    """{name: array} of ``names`` from the npz file ``path``.
+
+    ``expected``: {name: (shape, kind)} checked against each array's header
+    before it is read (:data:`KINDS`); an array of another shape or kind
+    is an :class:`OutputFolderError` naming it, and nothing is allocated."""
     try:
+        headers = array_headers(path, names)
+        missing = [name for name in names if name not in headers]
+        if missing:
+            raise OutputFolderError(path, f"has no {missing[0]!r}: it was written by an "
+                                    "older version; run the scene again to read it back")
+        for name, (shape, kind) in (expected or {}).items():
+            found, dtype = headers[name]
+            if dtype.kind not in KINDS[kind] or dtype.hasobject:
+                raise OutputFolderError(path, f"holds {name!r} of dtype {dtype}, not "
+                                        f"{ {'f': 'float', 'b': 'bool', 'i': 'int'}[kind]}: "
+                                        "the file is damaged; run the scene again")
+            if found != shape:
+                raise OutputFolderError(path, f"holds {name!r} of shape {found}, not {shape} "
+                                        "(of the problem and summary.json's run): the file "
+                                        "is damaged; run the scene again")
         with np.load(path, allow_pickle=False) as data:
-            missing = [name for name in names if name not in data.files]
-            if missing:
-                raise OutputFolderError(path, f"has no {missing[0]!r}: it was written by an "
-                                        "older version; run the scene again to read it back")
             return {name: data[name] for name in names}
     except FileNotFoundError:
         raise OutputFolderError(path, "no such file; an output folder of 'adhcontact solve' "
@@ -97,6 +138,27 @@ def _differing_key(a, b, prefix=""):
                 return found
         return None
     return None if a == b else prefix.rstrip(".") or "scene"
+
+
+def expected_arrays(problem, levels):
+    """{name: (shape, kind)} of the arrays of solution.npz for ``problem``
+    and a run of ``levels`` time levels (:func:`read_arrays`)."""
+    mesh, boundary, d = problem.mesh, problem.boundary, problem.dim
+    npoints, ncells = mesh.p.shape[1], mesh.t.shape[1]
+    nc = 0 if boundary is None else boundary.nodes.size
+    nf = 0 if boundary is None else boundary.facets.size
+    nprobes = 0 if problem.probe_map is None else problem.probe_map.shape[0]
+    L = levels
+    shapes = {"points": ((npoints, d), "f"), "t": ((L,), "f"), "u": ((L, npoints, d), "f"),
+              "beta": ((L, nf), "f"), "contact_force": ((L, nc, d), "f"),
+              "frame_displacement": ((L, nc, d), "f"), "on_wall": ((L, nc), "b"),
+              "stuck": ((L, nc), "b"), "probes": ((L, nprobes, d), "f"),
+              "iterations": ((L,), "i"), "residual": ((L,), "f"),
+              "held_reaction": ((L, problem.prescribed.fixed.size), "f"),
+              "stress_last": ((ncells, d, d), "f")}
+    if d == 2:
+        shapes["stress_zz_last"] = ((ncells,), "f")
+    return shapes
 
 
 def load_solution(folder, problem=None):
@@ -140,13 +202,15 @@ def load_solution(folder, problem=None):
                                 f"(they differ at {key})")
     names = ("points", "t", "u", "beta", "held_reaction", "stress_last") + SOLUTION_KEYS
     names += ("stress_zz_last",) if problem.dim == 2 else ()
-    arrays = read_arrays(npz_path, names)
-    if arrays["points"].shape != problem.mesh.p.T.shape or not np.array_equal(
-            arrays["points"], problem.mesh.p.T):
-        raise OutputFolderError(npz_path, "holds another mesh than the problem's")
     run = document["run"]
-    if run.get("status") not in STATUS or arrays["t"].shape != (run.get("levels"),):
-        raise OutputFolderError(summary_path, "its run record does not match solution.npz")
+    levels = run.get("levels") if isinstance(run, dict) else None
+    if not isinstance(run, dict) or run.get("status") not in STATUS or \
+            not isinstance(levels, int) or isinstance(levels, bool) or levels < 0:
+        raise OutputFolderError(summary_path, "its run record is damaged (run.status, "
+                                "run.levels); run the scene again")
+    arrays = read_arrays(npz_path, names, expected_arrays(problem, levels))
+    if not np.array_equal(arrays["points"], problem.mesh.p.T):
+        raise OutputFolderError(npz_path, "holds another mesh than the problem's")
     zz = arrays.get("stress_zz_last")
     return Solution(
         problem=problem, status=STATUS[run["status"]], message=run["message"], failure=None,

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .h5 import H5File
 from .xdmf import XdmfSeries
 
 #: kept per level in memory (small), as in HistoryRecorder
@@ -55,15 +56,13 @@ class StreamingRecorder:
     file (``names`` lists the files that stay)."""
 
     def __init__(self, problem, folder):
-        import h5py
-
         self.folder = Path(folder)
         self.series = XdmfSeries(problem, self.folder)
         self.names = list(self.series.names)
         levels = problem.scene.steps + 1
         npoints, d = problem.mesh.p.shape[1], problem.dim
-        self.scratch = h5py.File(self.folder / SCRATCH, "w")
-        self.u = self.scratch.create_dataset("u", (levels, npoints, d), dtype=float,
+        self.scratch = H5File(self.folder / SCRATCH, "w")   # a full disk raises (h5.py)
+        self.u = self.scratch.file.create_dataset("u", (levels, npoints, d), dtype=float,
                                              chunks=(1, npoints, d))
         self.small = {name: [] for name in SMALL}
         self.last = None
@@ -95,9 +94,13 @@ class StreamingRecorder:
     def close(self):
         """End the XDMF files and remove the scratch file (u is then gone
         from the Solution: write the npz and plots first)."""
-        self.series.close()
-        self.scratch.close()
-        (self.folder / SCRATCH).unlink(missing_ok=True)
+        try:
+            self.series.close()
+        finally:
+            try:
+                self.scratch.close()
+            finally:
+                (self.folder / SCRATCH).unlink(missing_ok=True)
 
 
 def _empty_shapes(problem):

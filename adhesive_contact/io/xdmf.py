@@ -14,9 +14,11 @@ Without h5py the data is written inline in the XDMF files."""
 from pathlib import Path
 
 import meshio
+from meshio._common import write_xml
 import numpy as np
 
 from ..postprocess.quantities import contact_fields, stress_3x3, von_mises
+from .h5 import H5File
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 REOPEN = 100   # levels between reopenings of the HDF5 file
@@ -35,22 +37,30 @@ class _SeriesWriter(meshio.xdmf.TimeSeriesWriter):
 
     def __enter__(self):
         self.levels = 0
+        self.h5 = None
         if self.data_format != "HDF":
             return super().__enter__()
-        import h5py
-
         self.h5_filename = str(self.filename.with_suffix(".h5"))
-        self.h5_file = h5py.File(self.h5_filename, "w")
+        self.h5 = H5File(self.h5_filename, "w")   # a full disk raises (io/h5.py)
+        self.h5_file = self.h5.file
         return self
 
     def write_data(self, t, point_data=None, cell_data=None):
         super().write_data(t, point_data=point_data, cell_data=cell_data)
         self.levels += 1
         if self.data_format == "HDF" and self.levels % REOPEN == 0:
-            import h5py
+            self.h5.close()
+            self.h5 = H5File(self.h5_filename, "a")
+            self.h5_file = self.h5.file
 
-            self.h5_file.close()
-            self.h5_file = h5py.File(self.h5_filename, "a")
+    def __exit__(self, *_):
+        """Write the XDMF file and close the HDF5 file (both, even when the
+        first raises)."""
+        try:
+            write_xml(self.filename, self.xdmf_file)
+        finally:
+            if self.h5 is not None:
+                self.h5.close()
 
 
 def data_format():
@@ -139,9 +149,16 @@ class XdmfSeries:
         return out
 
     def close(self):
+        """End both series; the first error is raised once both are closed."""
+        error = None
         for writer in (self.body, self.contact):
             if writer is not None:
-                writer.__exit__(None, None, None)
+                try:
+                    writer.__exit__(None, None, None)
+                except OSError as err:
+                    error = error or err
+        if error is not None:
+            raise error
 
 
 class _LevelOf:

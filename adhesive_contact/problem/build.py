@@ -190,6 +190,11 @@ def contact(scene, mesh, assembly, held, laws, times):
     boundary = build_contact_boundary(mesh, held.contact_facets, held.prescribed.fixed,
                                       scene.contact.quadrature, scene.contact.order,
                                       normal_field)
+    if boundary.facets.size and boundary.has_held and boundary.held.all():
+        raise SceneError("boundary.contact", f"every node of the contact sides "
+                         f"({', '.join(scene.contact_sides)}) is held in every component by a "
+                         f"held side ({', '.join(scene.held_sides)}): nothing on Γ_C is free; "
+                         "use a finer mesh (mesh.cells) or hold fewer sides")
     assert np.array_equal(assembly.nodal_dofs[:, boundary.nodes].T, boundary.dofs)
     # without friction only u_ν enters the contact terms (the traces of
     # the tangential components vanish on flat facets): solve for it alone

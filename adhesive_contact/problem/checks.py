@@ -13,14 +13,17 @@ Finite values. An expression can be well formed and still give ±inf or NaN (``9
 ``1e308*10``, ``sqrt(-1 - x)``, ``0/0``) at the points the scheme needs:
 such a load or kernel would only fail inside the time loop, or worse, give
 a quiet NaN. :func:`check_finite` evaluates an expression at given points
-and a sample of the time levels (:func:`sample_times`: t = 0, t = T and
-evenly spaced levels between) and raises
-:class:`~adhesive_contact.scene.SceneError` naming the key, the point and
-the time of the first value that is not finite. :func:`check_loads`,
-:func:`check_kernel` and :func:`check_exact` apply it to the loads at the
-quadrature points of the load map, the memory kernel at the lags of the
-time grid, and the exact solution at the mesh nodes; ``build_problem``
-calls them, since the points come from the geometry.
+and every time level of the run (:func:`check_on_grid`: all pairs of
+points and levels up to :data:`GRID_EVALUATIONS`, beyond that every level
+at an even sample of the points and every point at a sample of the
+levels) and raises :class:`~adhesive_contact.scene.SceneError` naming the
+key, the point and the time of the first value that is not finite:
+``1/(t - 0.01)`` with k = 0.01 is refused, not met at step 1.
+:func:`check_loads`, :func:`check_displacements`, :func:`check_kernel` and
+:func:`check_exact` apply it to the loads at the quadrature points of the
+load map, the prescribed displacements at their nodes, the memory kernel
+at the lags of the time grid, and the exact solution at the mesh nodes;
+``build_problem`` calls them, since the points come from the geometry.
 
 Held sides. :func:`check_prescribed`: sides that share a dof prescribe one
 value there, a held component of a scene with [exact] equals u*.
@@ -37,8 +40,12 @@ from ..expressions import coordinates
 from ..fem.dirichlet import rigid_modes
 from ..scene.errors import SceneError, where
 
-#: time levels sampled besides t = 0 and t = T
+#: time levels sampled besides t = 0 and t = T (where not every level is)
 TIME_SAMPLES = 16
+#: evaluations (points × time levels) of one expression checked pair by pair
+GRID_EVALUATIONS = 4 * 10**6
+#: entries evaluated at once
+_BLOCK = 2**16
 #: lags of the memory kernel checked one by one (more are sampled)
 KERNEL_LAGS = 10**6
 
@@ -74,6 +81,43 @@ def check_finite(key, field, points, times):
             check_values(key, row, points, t)
 
 
+def check_on_grid(key, expression, points, times):
+    """A scalar Expression finite at ``points`` (d, n) at every level of
+    ``times`` (the whole grid of the run), at most :data:`GRID_EVALUATIONS`
+    evaluations: every (point, level) pair when they fit, else every level
+    at an even sample of the points (one point when the levels alone pass
+    the budget: the levels are never sampled) and every point at
+    :func:`sample_times`. Evaluated in blocks, time along the columns."""
+    if not expression.depends_on_time:
+        times = times[:1]
+    if not expression.depends_on_space:
+        points = points[:, :1]
+    n, m = points.shape[1], times.size
+    if n * m <= GRID_EVALUATIONS:
+        _check_pairs(key, expression, points, times)
+        return
+    picks = np.unique(np.linspace(0, n - 1, max(1, GRID_EVALUATIONS // m)).round()
+                      .astype(np.int64))
+    _check_pairs(key, expression, points[:, picks], times)
+    _check_pairs(key, expression, points, sample_times(times))
+
+
+def _check_pairs(key, expression, points, times):
+    n = points.shape[1]
+    columns = max(1, _BLOCK // n)
+    for start in range(0, times.size, columns):
+        t = times[start:start + columns]
+        shape = (n, t.size)   # the expression gives the shape of x
+        x = [None if c is None else np.broadcast_to(c[:, None], shape)
+             for c in coordinates(points)]
+        values = expression(*x, t=np.broadcast_to(t[None, :], shape))
+        bad = ~np.isfinite(values)
+        if bad.any():
+            i, j = np.argwhere(bad)[np.argmin(np.argwhere(bad)[:, 1])]
+            raise SceneError(key, f"is not finite: {values[i, j]:g} at "
+                             f"{where(points, int(i), float(t[j]))}")
+
+
 def check_loads(keyed_fields, loads, times):
     """The loads finite at the quadrature points of the load map (at one
     point for an expression that does not use x, y, z: its value is the
@@ -82,11 +126,14 @@ def check_loads(keyed_fields, loads, times):
     ``keyed_fields`` lists, parallel to ``loads.parts``, the fields to check
     there as (key, field) pairs: a scene's expressions one component at a
     time, so that the key names the component."""
-    sample = sample_times(times)
     for fields, (_, load) in zip(keyed_fields, loads.parts):
         for key, field in fields:
             points = load.points if getattr(field, "depends_on_space", True) else load.anchor
-            check_finite(key, field, points.reshape(points.shape[0], -1), sample)
+            points = points.reshape(points.shape[0], -1)
+            if getattr(field, "uses", None) is not None:   # a scene's expression
+                check_on_grid(key, field, points, times)
+            else:
+                check_finite(key, field, points, sample_times(times))
 
 
 def check_kernel(key, r, k, steps):
@@ -115,12 +162,21 @@ def check_exact(exact, points, times):
 # ---------------------------------------------------------------- held sides
 
 
+def check_displacements(rows, scene, mesh, times):
+    """Every prescribed displacement finite at its nodes at every level."""
+    d = mesh.dim()
+    for s, c, dofs, expr, key in rows:
+        if scene.held_sides[s] not in scene.dirichlet:
+            check_on_grid(key, expr, mesh.p[:, dofs // d], times)
+
+
 def check_prescribed(prescribed, scene, mesh):
     """The held components of a scene (a
     :class:`~adhesive_contact.fem.dirichlet.PrescribedDisplacement`) are
     consistent: one value at every dof held by several sides, u* on the
     held sides of a scene with [exact]."""
     times = scene.k * np.arange(scene.steps + 1)
+    check_displacements(prescribed.entries, scene, mesh, times)
     _check_agreement(prescribed.entries, prescribed.fixed, prescribed.count, mesh, times)
     if scene.exact is not None:
         _check_exact_held(prescribed.entries, scene, mesh, times)
@@ -214,19 +270,55 @@ def restraining_rows(modes, boundary, normal, wall, tangential):
 
 
 def check_rigid_motions(mesh, fixed, sides, contact=None):
+    """Refuse a scene that leaves a rigid motion of the body free (see
+    :func:`_check_motions`); a file mesh of several connected parts without
+    contact terms is checked part by part (a part no held side holds would
+    make the stiffness singular)."""
+    parts = mesh_parts(mesh)
+    if contact is None and parts.max() > 0:
+        d = mesh.dim()
+        for part in range(parts.max() + 1):
+            nodes = np.flatnonzero(parts == part)
+            held = fixed[np.isin(fixed // d, nodes)]
+            try:
+                _check_motions(mesh.p[:, nodes],
+                               np.searchsorted(nodes, held // d) * d + held % d, sides)
+            except SceneError as err:
+                centre = mesh.p[:, nodes].mean(axis=1)
+                raise SceneError("boundary", f"the part of the mesh around "
+                                 f"{where(centre)} ({nodes.size} nodes, not connected to "
+                                 f"the rest): {str(err).removeprefix('boundary: ')}") \
+                    from None
+        return
+    _check_motions(mesh.p, fixed, sides, contact)
+
+
+def mesh_parts(mesh):
+    """The connected part of each node (0, 1, ...; nodes of no cell apart)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    t = mesh.t
+    rows = np.repeat(t[:1], t.shape[0] - 1, axis=0).ravel()
+    graph = coo_matrix((np.ones(rows.size), (rows, t[1:].ravel())),
+                       shape=(mesh.p.shape[1],) * 2)
+    return connected_components(graph, directed=False)[1]
+
+
+def _check_motions(points, fixed, sides, contact=None):
     """Refuse a scene that leaves a rigid motion of the body free: one that
     vanishes at the held dofs ``fixed`` and, with ``contact`` (the rows of
     :func:`restraining_rows` and a phrase naming the contact terms), changes
     none of the contact terms. The message lists exactly the motions left
     free (:func:`describe_motions`)."""
-    modes = rigid_modes(mesh.p)
+    modes = rigid_modes(points)
     free = free_rigid_motions(modes, fixed)
     if contact is not None and free.shape[1]:
         rows, terms = contact
         free = free @ _null_space(rows @ free, free.shape[1])
     if free.shape[1] == 0:
         return
-    motions = describe_motions(free, mesh.p)
+    motions = describe_motions(free, points)
     held = ", ".join(sides) or "none"
     if contact is None:
         start = f"the held sides ({held}) leave the body free to move rigidly"

@@ -3,6 +3,7 @@ foundation), the quadrature on Γ_C, and the normal, friction and bonding
 laws of :mod:`adhesive_contact.laws`."""
 
 import math
+import sys
 
 from ..laws import FRICTION_LAWS
 from .errors import SceneError
@@ -107,7 +108,17 @@ def _point(table, name, dim, nonzero=False):
         raise SceneError(table.key(name), f"must be a list of {dim} numbers, got {show(value)}")
     if nonzero and not any(value):
         raise SceneError(table.key(name), "must be a nonzero vector")
+    squared = sum(float(c) * float(c) for c in value)
+    if nonzero and not sys.float_info.min <= squared <= sys.float_info.max:
+        # |v|² under- or overflows: the unit vector v/|v| would be 0 or NaN
+        raise SceneError(table.key(name), f"{show(value)} has a length whose square "
+                         f"{'underflows' if squared < 1 else 'overflows'} in floating point; "
+                         "give the direction with components of moderate size, e.g. [0, 1]")
     return tuple(float(c) for c in value)
+
+
+#: the largest radius of a foundation (its square and products stay finite)
+MAX_LENGTH = 1e100
 
 
 def _read_foundation(table, dim):
@@ -116,11 +127,18 @@ def _read_foundation(table, dim):
         return None
     shape = table.read("shape", dim)
     point = _point(table, "point", dim)
+    if not max(abs(c) for c in point) <= MAX_LENGTH:   # distances to it square it
+        raise SceneError(table.key("point"), f"{show(list(point))} is too far out (each "
+                         f"coordinate at most {MAX_LENGTH:g} in absolute value)")
     normal = axis = radius = None
     if shape == "plane":
         normal = _point(table, "normal", dim, nonzero=True)
     else:
         radius = table.read("radius")
+        if not radius <= MAX_LENGTH:   # the ray-sphere intersection squares it
+            raise SceneError(table.key("radius"), f"{radius:g} is too large (at most "
+                             f"{MAX_LENGTH:g}: the gap squares it); a plane is the limit of "
+                             "a large sphere: use shape = \"plane\"")
     if shape == "cylinder":
         axis = _point(table, "axis", dim, nonzero=True)
     table.finish()

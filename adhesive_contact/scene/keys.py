@@ -124,6 +124,7 @@ MAX_TITLE = 500             # characters of the title (it heads every plot)
 MAX_CELL_ASPECT = 1e3       # longest over shortest edge of the structured cells
 MAX_NODES = 10**8           # nodes of the refined mesh
 MAX_UNIT = 16               # characters of a unit name in output.units
+MAX_MODULUS = 1e100         # |λ|, μ of a tensor (and of the sums of a memory kernel)
 
 _DECLARATIONS = (
     Key("title", "str", "untitled", "the scene's title (it heads every plot)"),

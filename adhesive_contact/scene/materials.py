@@ -2,8 +2,19 @@
 by a Young or a Lamé pair, and the memory kernels built of them."""
 
 from .errors import SceneError
+from .keys import MAX_MODULUS
 from .reader import Table
 from .spec import Isotropic, MemorySpec, PronyTerm
+
+
+def _moderate(key, lam, mu, what="the tensor"):
+    """Refuse Lamé parameters beyond MAX_MODULUS: the stiffness matrix sums
+    them times the squared gradients of the shape functions, and overflows
+    to inf or NaN (E = 1e308 failed in the step solve)."""
+    if not (abs(lam) <= MAX_MODULUS and mu <= MAX_MODULUS):
+        raise SceneError(key, f"gives {what} lam = {lam:.3g}, mu = {mu:.3g}, beyond "
+                         f"{MAX_MODULUS:g}, where the stiffness matrix overflows; give the "
+                         "moduli in other units (e.g. MPa or GPa)")
 
 
 def _isotropic(table, dim):
@@ -18,11 +29,13 @@ def _isotropic(table, dim):
         if not lam + 2.0 * mu / dim > 0:
             raise SceneError(table.key("lam"),
                              f"must give a positive bulk modulus lam + 2 mu/{dim} > 0")
+        _moderate(table.key("lam"), lam, mu)
         return Isotropic(lam, mu)
     E = table.read("E")
     nu = table.read("nu")
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     mu = E / (2.0 * (1.0 + nu))
+    _moderate(table.key("E"), lam, mu)
     return Isotropic(lam, mu, E, nu)
 
 
@@ -62,6 +75,9 @@ def read_memory(table, dim):
         t.finish()
         terms.append(PronyTerm(tensor, tau))
     table.finish()
+    parts = [t.tensor for t in terms] + ([long_term] if long_term is not None else [])
+    _moderate(table.key("terms"), sum(p.lam for p in parts), sum(p.mu for p in parts),
+              "summed over its terms")
     return MemorySpec(kernel, terms=tuple(terms), long_term=long_term)
 
 

@@ -3,6 +3,8 @@
 solver, the outputs and a manufactured solution."""
 
 import hashlib
+import os
+import stat
 from pathlib import Path
 
 from ..expressions import compile_expression
@@ -70,11 +72,17 @@ def _read_mesh_file(table, dim, base_dir, refine):
     it is read when the problem is built."""
     given = table.read("file")
     table.finish()
-    path = Path(given).expanduser()
+    if "\0" in given:
+        raise SceneError(table.key("file"), "the path holds a NUL character")
+    try:
+        path = Path(given).expanduser()
+    except RuntimeError:   # ~user of no such user
+        raise SceneError(table.key("file"), f"{given!r}: no such user's home folder "
+                         f"({given.split('/')[0]})") from None
     if not path.is_absolute():
         path = Path(base_dir if base_dir is not None else Path.cwd()) / path
     try:
-        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        digest = _file_sha256(table.key("file"), path)
     except FileNotFoundError:
         raise SceneError(table.key("file"), f"no such file {str(path)!r} (a path relative "
                          "to the scene file's folder)") from None
@@ -83,6 +91,24 @@ def _read_mesh_file(table, dim, base_dir, refine):
                          f"{err.strerror or err}") from None
     return MeshSpec("file", refine=refine, file=given, path=str(path.resolve()),
                     sha256=digest, dim=dim)
+
+
+def _file_sha256(key, path):
+    """The sha256 of a regular file, read in blocks. Anything else (a FIFO,
+    which would block the read, a device such as /dev/zero, which never
+    ends, a folder) is refused before it is opened."""
+    mode = os.stat(path).st_mode
+    if not stat.S_ISREG(mode):
+        kind = ("a folder" if stat.S_ISDIR(mode) else "a named pipe (FIFO)"
+                if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
+                stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "not a file")
+        raise SceneError(key, f"{str(path)!r} is {kind}, not a regular file; give a mesh "
+                         "file")
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def read_boundary(table, dim, named_by_file=False):

@@ -55,7 +55,8 @@ from ..verification.levels import (
     with_discretisation,
 )
 from ..fem.meshes import build_mesh
-from ..scene import scene_from_dict
+from ..scene import SceneError, scene_from_dict
+from ..scene.materials import check_relaxation_step
 from ..storage import write_atomic, write_json
 from .pool import attempt
 from .study import RunFailed, Study, StudyError, scene_identity, scene_source
@@ -351,6 +352,12 @@ class ConvergenceStudy(Study):
             raise StudyError("levels", f"must be an integer >= 2, got {levels!r}")
         self.base = (refine, steps)
         self.scene = with_discretisation(given, refine, steps)
+        memory = self.scene.memory
+        if steps is not None and memory is not None and memory.kernel == "relaxation":
+            try:   # level 0 has the largest step: the scene's own check, for it
+                check_relaxation_step(memory, self.scene.dim, self.scene.k)
+            except SceneError as err:
+                raise StudyError("steps", str(err).removeprefix(f"{err.key}: ")) from None
         self.param, self.levels = param, levels
         if reference is None:
             reference = ("exact" if self.scene.exact is not None and quantity is None

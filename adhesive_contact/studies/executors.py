@@ -32,14 +32,19 @@ From Python::
         Sweep(scene, settings, folder="out").run(executor=executor)
 """
 
+import socket
+import struct
+import threading
 import time
 
 #: seconds to wait for a scheduler before giving up
 CONNECT_TIMEOUT = 5.0
 #: seconds between two looks at the cluster while waiting for runs
 POLL = 2.0
-#: the address schemes of the form host:port
+#: the address schemes of the form host:port, the only ones a study may use
 HOST_PORT_SCHEMES = ("tcp", "tls", "ws", "wss")
+#: the largest first message (bytes) a scheduler's handshake may have
+HANDSHAKE_BYTES = 1 << 20
 #: seconds between two looks for finished runs
 WAKE = 0.02
 
@@ -176,13 +181,87 @@ def dask_executor(scheduler, *, timeout=None, patience=60.0):
         scheme, location = distributed.comm.parse_address(scheduler)
         distributed.comm.registry.get_backend(scheme)
         if scheme in HOST_PORT_SCHEMES:
-            distributed.comm.addressing.parse_host_port(location)
-    except ValueError as err:
+            host, port = distributed.comm.addressing.parse_host_port(location)
+    except (ValueError, TypeError) as err:
         raise ClusterError(scheduler, f"not a scheduler address ({err}); expected e.g. "
                            "tcp://host:8786") from None
+    deadline = time.monotonic() + timeout
+    if scheme in HOST_PORT_SCHEMES:   # inproc:// (this process) and ucx:// are not probed
+        probe_scheduler(scheduler, scheme, host, port, timeout)
+    return DaskExecutor(_client(distributed, scheduler, deadline, timeout), own=True,
+                        patience=patience)
+
+
+def _no_answer(scheduler, timeout):
+    return ClusterError(scheduler, f"no dask scheduler answered there within {timeout:g} s")
+
+
+def probe_scheduler(scheduler, scheme, host, port, timeout):
+    """Check within ``timeout`` seconds that a dask scheduler listens at
+    ``host:port``: the connection is accepted and (``tcp``) the first
+    message of the handshake, which a scheduler sends at once, arrives: an
+    8-byte length of at most :data:`HANDSHAKE_BYTES`, then that many bytes.
+    A closed port, a listener that stays silent (an HTTP server waits for a
+    request) or one that sends anything else is a :class:`ClusterError`."""
+    deadline = time.monotonic() + timeout
     try:
-        client = distributed.Client(scheduler, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError):
-        raise ClusterError(scheduler, f"no dask scheduler answered there within {timeout:g} s"
-                           ) from None
-    return DaskExecutor(client, own=True, patience=patience)
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except (OSError, ValueError, OverflowError):
+        raise _no_answer(scheduler, timeout) from None
+    try:
+        if scheme != "tcp":   # TLS and websockets: the client's bounded wait below
+            return
+        try:
+            (size,) = struct.unpack("Q", _receive(sock, 8, deadline))   # as distributed
+            if not 0 < size <= HANDSHAKE_BYTES:
+                raise ClusterError(scheduler, "something answers there, but not a dask "
+                                   "scheduler (its first message is not a handshake)")
+            _receive(sock, size, deadline)
+        except (OSError, EOFError):
+            raise ClusterError(scheduler, "something accepts connections there but does "
+                               f"not answer as a dask scheduler within {timeout:g} s") from None
+    finally:
+        sock.close()
+
+
+def _receive(sock, count, deadline):
+    """``count`` bytes from ``sock`` before ``deadline`` (socket.timeout or
+    EOFError otherwise)."""
+    data = bytearray()
+    while len(data) < count:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise socket.timeout("handshake")
+        sock.settimeout(left)
+        chunk = sock.recv(min(count - len(data), 1 << 16))
+        if not chunk:
+            raise EOFError("closed")
+        data += chunk
+    return bytes(data)
+
+
+def _client(distributed, scheduler, deadline, timeout):
+    """A ``distributed.Client`` of ``scheduler``, connected before
+    ``deadline`` (and a few seconds' grace) or a :class:`ClusterError`:
+    the client is made in a daemon thread, so whatever answers, waiting is
+    bounded."""
+    box = {}
+
+    def connect():
+        try:
+            box["client"] = distributed.Client(
+                scheduler, timeout=max(deadline - time.monotonic(), 0.5),
+                set_as_default=False)
+        except BaseException as err:   # reported below, in the caller's thread
+            box["error"] = err
+
+    thread = threading.Thread(target=connect, name="adhcontact-connect", daemon=True)
+    thread.start()
+    thread.join(max(deadline - time.monotonic(), 0.0) + 5.0)
+    if thread.is_alive() or "client" not in box:
+        error = box.get("error")
+        if error is None or isinstance(error, (OSError, TimeoutError)):
+            raise _no_answer(scheduler, timeout)
+        raise ClusterError(scheduler, "the connection failed "
+                           f"({type(error).__name__}: {' '.join(str(error).split())[:200]})")
+    return box["client"]

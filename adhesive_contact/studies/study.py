@@ -24,7 +24,7 @@ from abc import ABC, abstractmethod
 from pathlib import Path
 
 from ..scene import SceneError
-from ..storage import plain, read_json, write_json
+from ..storage import plain, read_json, remove_stale_temporaries, write_json
 from .pool import execute
 
 STUDY_FILE = "study.json"
@@ -223,9 +223,14 @@ class Study(ABC):
     def create(self, extra=None):
         """Open the folder (see :meth:`open`) and, for a new study, write
         ``study.json`` (with the ``extra`` entries, not hashed); make the
-        folder of the run records. True when a saved study is resumed."""
+        folder of the run records. The temporary files that a killed study's
+        atomic writes left are removed
+        (:func:`~adhesive_contact.storage.remove_stale_temporaries`). True
+        when a saved study is resumed."""
         resume = self.open()
         self.folder.mkdir(parents=True, exist_ok=True)
+        for folder in (self.folder, self.folder / self.runs_folder):
+            remove_stale_temporaries(folder)   # of a killed study's atomic writes
         if not resume:
             write_json(self.folder / STUDY_FILE, {**self.document, **(extra or {})})
         (self.folder / self.runs_folder).mkdir(exist_ok=True)

@@ -4,9 +4,10 @@ A setting is a dotted TOML key and its values, e.g.
 ``("contact.normal.c", [1e2, 1e3])`` or ``("time.steps", [10, 20])``; an
 integer part indexes an array of tables (``contact.friction.0.mu``). The
 variants are the grid of all combinations (``mode="grid"``, the last key
-varying fastest) or the settings taken in step (``"zip"``, equal lengths).
-Every variant's scene is validated (parsed and discretised) before
-anything runs.
+varying fastest) or the settings taken in step (``"zip"``, equal lengths),
+at most :data:`MAX_VARIANTS` unless forced. Each value of each setting is
+validated (parsed and discretised) before anything runs; a combination of
+valid values that is not a valid scene is a failed run.
 
 A run that fails (a step solve that did not converge) is a result, not an
 error: its record says where it stopped. A run whose worker died (a killed
@@ -30,12 +31,15 @@ From Python::
 
 import copy
 import csv
+import hashlib
+import math
 import itertools
 import re
 import resource
 import time
 import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.quantities import beta_mean
@@ -46,6 +50,9 @@ from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
 
 MODES = ("grid", "zip")
+#: the most variants a sweep has unless forced: each is a run (10⁴ variants
+#: were minutes of validation alone, 10⁶ hours)
+MAX_VARIANTS = 1000
 OUTCOMES = ("ok", "failed")
 #: the outcome of a run whose worker died: a row, never a saved record
 LOST = "lost"
@@ -54,6 +61,8 @@ MEASURED = ("outcome", "failed_step", "failed_t", "residual", "seconds", "newton
             "newton_max", "worker_peak_rss_mib", "beta_min_T", "beta_mean_T",
             "max_un_minus_g", "separated_T", "on_wall_T", "compliance_T", "stick_T",
             "slip_T", "normal_force_T")
+#: the deepest nesting of brackets in a value given to --set
+MAX_VALUE_DEPTH = 16
 _BARE = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
 
@@ -85,6 +94,19 @@ def parse_value(text):
     word that is not TOML (``gauss``) is taken as a string.
 
     Raises ValueError naming the text when it is neither."""
+    depth = level = 0
+    quote = None
+    for char in text:   # before the parser, which recurses per bracket
+        if quote:
+            quote = None if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        else:
+            level += (char in "[{") - (char in "]}")
+            depth = max(depth, level)
+    if depth > MAX_VALUE_DEPTH:
+        raise ValueError(f"a value nested {depth} deep (at most {MAX_VALUE_DEPTH} levels of "
+                         "brackets)")
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
@@ -142,11 +164,19 @@ def with_value(document, key, value):
     return out
 
 
-def variants(settings, mode="grid"):
+def variant_count(settings, mode="grid"):
+    """How many variants the settings give (without making them)."""
+    lengths = [len(list(values)) for _, values in settings]
+    return (math.prod(lengths) if mode == "grid" else min(lengths)) if lengths else 0
+
+
+def variants(settings, mode="grid", force=False):
     """The variants of a sweep: a list of {key: value}, in run order.
 
     Raises :class:`StudyError` for an unknown mode, no settings, a key set
-    twice or (zip) lists of different lengths."""
+    twice, (zip) lists of different lengths, or more than
+    :data:`MAX_VARIANTS` variants unless ``force`` (counted before any is
+    made)."""
     if mode not in MODES:
         raise StudyError("mode", f"must be grid or zip, got {mode!r}")
     settings = [(key, list(values)) for key, values in settings]
@@ -158,6 +188,13 @@ def variants(settings, mode="grid"):
             raise StudyError(f"set {key}", "set twice; give all its values in one --set")
         if not values:
             raise StudyError(f"set {key}", "no values")
+    count = variant_count(settings, mode)
+    if count > MAX_VARIANTS and not force and (mode == "grid" or len(
+            {len(values) for _, values in settings}) == 1):
+        sizes = " x ".join(str(len(values)) for _, values in settings)
+        raise StudyError("set", f"gives {count:,} variants ({sizes}"
+                         f"{'' if mode == 'grid' else ', zipped'}); at most {MAX_VARIANTS:,} "
+                         "unless forced (--force): each variant is a run")
     if mode == "zip":
         length = len(settings[0][1])
         for key, values in settings[1:]:
@@ -168,6 +205,24 @@ def variants(settings, mode="grid"):
     else:
         combos = itertools.product(*(values for _, values in settings))
     return [dict(zip(keys, combo)) for combo in combos]
+
+
+def file_sha256(given, base_dir=None):
+    """The sha256 of the file ``given`` (relative to ``base_dir``), None when
+    it cannot be read (the variant's check then names it)."""
+    path = Path(given).expanduser()
+    if not path.is_absolute():
+        path = Path(base_dir if base_dir is not None else Path.cwd()) / path
+    try:
+        if not path.is_file():
+            return None
+        digest = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                digest.update(block)
+        return digest.hexdigest()
+    except (OSError, RuntimeError):
+        return None
 
 
 def variant_document(document, values):
@@ -199,8 +254,9 @@ def _at_T(values):
     return None if values is None else values[-1]
 
 
-def run_variant(document, values):
-    """Build and solve one variant; its record (plain JSON).
+def run_variant(document, values, base_dir=None):
+    """Build and solve one variant; its record (plain JSON). A relative
+    ``mesh.file`` is taken in ``base_dir`` (the scene file's folder).
 
     Keys: ``values`` ({key: value}), ``outcome`` ("ok" or "failed"),
     ``failure`` (None, or {step, t, residual, iterations, message}),
@@ -221,10 +277,16 @@ def run_variant(document, values):
     A failed run has None for what needs the solution.
     """
     t0 = time.perf_counter()
-    problem = build_problem(scene_from_dict(variant_document(document, values)))
+    record = {"values": values, "worker_peak_rss_mib": peak_rss_mib()}
+    try:
+        problem = build_problem(scene_from_dict(variant_document(document, values), base_dir))
+    except (SceneError, ValueError) as err:   # a combination of values checked one by one
+        return plain(record | {
+            "outcome": "failed", "seconds": time.perf_counter() - t0, "residual": None,
+            "failure": {"step": None, "t": None, "residual": None, "iterations": None,
+                        "message": f"not a valid scene: {err}"}})
     solution, failure = solve_or_failure(problem)
-    record = {"values": values, "seconds": time.perf_counter() - t0,
-              "worker_peak_rss_mib": peak_rss_mib()}
+    record |= {"seconds": time.perf_counter() - t0, "worker_peak_rss_mib": peak_rss_mib()}
     if failure is not None:
         result = failure.result
         return plain(record | {
@@ -248,13 +310,13 @@ def run_variant(document, values):
         "warnings": solution_warnings(solution)})
 
 
-def _setup(document, runs):
-    return document, runs
+def _setup(document, runs, base_dir=None):
+    return document, runs, base_dir
 
 
 def _compute_run(state, key):
-    document, runs = state
-    return {"run": key} | run_variant(document, runs[key])
+    document, runs, base_dir = state
+    return {"run": key} | run_variant(document, runs[key], base_dir)
 
 
 # ---------------------------------------------------------------- rows
@@ -285,6 +347,7 @@ def run_row(record, keys, quantities=()):
     for column in quantities:
         row[column] = given.get(column)
     row.update(failed_step=failure.get("step"), failed_t=failure.get("t"))
+    row["message"] = failure.get("message")   # printed, not a column of runs.csv
     return row
 
 
@@ -345,31 +408,58 @@ class Sweep(Study):
         Dotted TOML keys and their values (see the module docstring).
     mode : {"grid", "zip"}
     folder : path of the sweep's folder
+    base_dir : the folder a relative ``mesh.file`` (of the scene or of a
+        setting) is taken in; by default the scene file's folder (the
+        working directory for a text or a document)
+
+    The study's identity holds the sha256 of every mesh file a variant
+    reads, so a sweep whose mesh file changed is another sweep.
+
+    force : allow more than :data:`MAX_VARIANTS` variants
 
     Raises
     ------
     SceneError for a bad base scene; StudyError naming the setting
-    (``key`` ``"set KEY"``) when a variant is not a valid scene, before
-    anything runs or is written. ``warnings`` lists (variant, warning) of
-    what the theory does not cover.
+    (``key`` ``"set KEY"``) when a value makes the scene invalid, before
+    anything runs or is written. Each value of each setting is checked
+    (applied to the first variant; in zip mode every variant is checked):
+    as many builds as values, not as variants. A combination of valid
+    values that is not a valid scene is found when it runs, and is a failed
+    run saying why. ``warnings`` lists (variant, warning) of what the theory
+    does not cover, for the variants checked.
     """
 
     kind = "parameter sweep"
     runs_folder = "runs"
     compute = _compute_run
 
-    def __init__(self, scene, settings, mode="grid", *, folder):
+    def __init__(self, scene, settings, mode="grid", *, folder, base_dir=None, force=False):
         super().__init__(folder)
+        if base_dir is None and not isinstance(scene, (str, dict)):
+            base_dir = Path(scene).absolute().parent
+        self.base_dir = None if base_dir is None else str(Path(base_dir).absolute())
         self.source = scene_source(scene)
-        self.base = scene_from_dict(self.source)
+        self.base = scene_from_dict(self.source, self.base_dir)
         self.settings = [(key, list(values)) for key, values in settings]
         self.mode = mode
-        self.runs = variants(self.settings, mode)
+        self.runs = variants(self.settings, mode, force)
         self.keys_set = [key for key, _ in self.settings]
         self.warnings = []
-        for index, values in enumerate(self.runs):
-            problem = self._check(values)
+        for index in self.checked():
+            problem = self._check(self.runs[index])
             self.warnings += [(index, str(w)) for w in problem.warnings()]
+
+    def checked(self):
+        """The indices of the variants checked before anything runs: in zip
+        mode all; in grid mode, for each setting, the first variant taking
+        each of its values (the first variant with that key changed), in
+        run order."""
+        if self.mode == "zip":
+            return list(range(len(self.runs)))
+        lengths = [len(values) for _, values in self.settings]
+        strides = [math.prod(lengths[i + 1:]) for i in range(len(lengths))]
+        return sorted({j * stride for length, stride in zip(lengths, strides)
+                       for j in range(length)})
 
     def _check(self, values):
         """The problem of one variant, or StudyError naming the setting at fault."""
@@ -380,7 +470,7 @@ class Sweep(Study):
             except ValueError as err:
                 raise StudyError(f"set {key}", str(err)) from None
         try:
-            return build_problem(scene_from_dict(document))
+            return build_problem(scene_from_dict(document, self.base_dir))
         except SceneError as err:
             if err.key in values:
                 reason = str(err).removeprefix(f"{err.key}: ")
@@ -390,8 +480,20 @@ class Sweep(Study):
                 from None
 
     def identity(self):
-        return {"scene": scene_identity(self.base), "set": [[k, v] for k, v in self.settings],
-                "mode": self.mode}
+        identity = {"scene": scene_identity(self.base),
+                    "set": [[k, v] for k, v in self.settings], "mode": self.mode}
+        files = self.files_read()
+        return identity | ({"files": files} if files else {})
+
+    def files_read(self):
+        """[[value, sha256], ...] of the mesh files that the settings name
+        (the base scene's own is in its resolved record), in the order set."""
+        files = []
+        for key, values in self.settings:
+            if key == "mesh.file":
+                for value in dict.fromkeys(v for v in values if isinstance(v, str)):
+                    files.append([value, file_sha256(value, self.base_dir)])
+        return files
 
     def keys(self):
         return list(range(len(self.runs)))
@@ -405,7 +507,7 @@ class Sweep(Study):
                 and record.get("values") == plain(self.runs[key]))
 
     def context(self):
-        return _setup, (self.source, self.runs)
+        return _setup, (self.source, self.runs, self.base_dir)
 
     def run(self, jobs=1, executor=None, as_completed=None, progress=None):
         """Compute the runs not saved yet, then write ``runs.csv``.

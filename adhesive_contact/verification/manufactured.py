@@ -59,12 +59,59 @@ def _constant(node):
     return float(Expression("", node, ())(0.0))
 
 
+#: the sizes of an expression sympy is given: its derivation (two
+#: derivatives, then code for numpy) grows with the square of a product's
+#: factors and with the depth of nested functions; at these bounds a scene
+#: builds in about 2 s (16 factors x*(x + 1)*...*(x + 14)*t: 2.2 s, 10 nested
+#: sin: 1.4 s, of which 1.2 s setting up; 40 factors took 24 s, 40 nested sin
+#: 7.5 s, and 199 factors or 98 nested sin did not end in a minute)
+MAX_FACTORS = 16
+MAX_NESTING = 10
+MAX_VARIABLE_NODES = 80
+
+
+def _size_problem(tree):
+    """Why an expression tree is too large for sympy (None when it is not):
+    more than MAX_FACTORS factors depending on x, y, z or t in one product,
+    functions of them nested deeper than MAX_NESTING, or more than
+    MAX_VARIABLE_NODES operations on them."""
+    dependent = [n for n in ast.walk(tree) if isinstance(n, ast.expr)
+                 and not isinstance(n, ast.Name) and not _variable_free(n)]
+    if len(dependent) > MAX_VARIABLE_NODES:
+        return (f"it has {len(dependent)} operations on x, y, z, t (at most "
+                f"{MAX_VARIABLE_NODES})")
+    for node in dependent:
+        if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Mult, ast.Div)):
+            factors, left = [], node   # the left-nested chain a*b/c*... of this product
+            while isinstance(left, ast.BinOp) and isinstance(left.op, (ast.Mult, ast.Div)):
+                factors.append(left.right)
+                left = left.left
+            count = sum(not _variable_free(f) for f in factors + [left])
+            if count > MAX_FACTORS:
+                return (f"a product of {count} factors depending on x, y, z, t (at most "
+                        f"{MAX_FACTORS})")
+
+    def nesting(node):
+        inner = max((nesting(child) for child in ast.iter_child_nodes(node)), default=0)
+        return inner + (isinstance(node, ast.Call) and not _variable_free(node))
+
+    depth = nesting(tree)
+    if depth > MAX_NESTING:
+        return f"functions of x, y, z, t nested {depth} deep (at most {MAX_NESTING})"
+    return None
+
+
 def symbolic_problem(expression):
     """Why sympy must not be given ``expression`` (an Expression), or None.
 
-    Refused: a constant part that is not finite (``1/0``, ``1e308*10``), and
-    a power with a constant exponent beyond ±MAX_EXPONENT. Checked on
-    floats, before sympy sees anything, so the check itself is fast."""
+    Refused: a constant part that is not finite (``1/0``, ``1e308*10``), a
+    power with a constant exponent beyond ±MAX_EXPONENT, and an expression
+    beyond the sizes above (:func:`_size_problem`), whose derivation would
+    not end in reasonable time. Checked on floats and on the tree, before
+    sympy sees anything, so the check itself is fast."""
+    size = _size_problem(expression._tree)
+    if size:
+        return f"too large for the symbolic derivation: {size}"
     for node in ast.walk(expression._tree):
         if not isinstance(node, ast.expr) or isinstance(node, (ast.Constant, ast.Name)) \
                 or not _variable_free(node):

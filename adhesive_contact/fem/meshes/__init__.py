@@ -58,6 +58,9 @@ def named_facets(mesh, names, key, indexed=True):
             have = ", ".join(sorted(groups)) or "none"
             raise SceneError(where, f"the mesh has no boundary group {name!r}; its groups "
                              f"are: {have}")
+        if not len(groups[name]):   # a side that would silently hold or touch nothing
+            raise SceneError(where, f"the mesh's boundary group {name!r} is empty (no "
+                             "facets); in gmsh, put the side's curves (surfaces in 3D) in it")
         if not boundary[groups[name]].all():
             raise SceneError(where, f"group {name!r} has facets inside the body; a side "
                              "must lie on the boundary")

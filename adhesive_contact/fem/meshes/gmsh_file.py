@@ -39,18 +39,27 @@ def _topological_dim(cell_type):
 
 
 def _read(path):
+    """meshio's mesh of ``path``; what meshio prints (its warnings go to
+    stderr) is kept out of the terminal and, when the file cannot be read,
+    joined into the one line of the error."""
     import meshio
+    printed = io.StringIO()
     try:
-        with contextlib.redirect_stdout(io.StringIO()):   # meshio prints on some formats
+        with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
             return meshio.read(path)
-    except Exception as err:   # meshio raises many kinds on a malformed file
-        reason = " ".join(str(err).split()) or type(err).__name__
-        raise MeshFileError(f"cannot read {Path(path).name!r} as a mesh: {reason}") from None
+    except (Exception, SystemExit) as err:   # meshio raises many kinds (and may exit)
+        reason = (" ".join(str(err).split()) if not isinstance(err, SystemExit) else
+                  "meshio gave up on it") or type(err).__name__
+        said = " ".join(printed.getvalue().split())
+        raise MeshFileError(f"cannot read {Path(path).name!r} as a mesh: {reason}"
+                            + (f" (meshio: {said[:300]})" if said else "")) from None
 
 
 def _points(raw, dim, name):
     """The points (dim, n): a 2D file's z column must be zero and is dropped."""
     p = np.asarray(raw.points, dtype=float)
+    if p.ndim != 2 or not p.shape[0]:   # a file cut short may leave none
+        raise MeshFileError(f"{name!r} has no nodes (is the file complete?)")
     if p.shape[1] < dim:
         raise MeshFileError(f"{name!r} has {p.shape[1]}D points, the scene has dim = {dim}")
     if p.shape[1] > dim:
@@ -102,6 +111,46 @@ def _facet_groups(raw, dim):
     return groups
 
 
+#: the extent of a mesh (its bounding box's largest side): cell measures are
+#: products of d coordinates, which under- or overflow beyond these
+MIN_EXTENT, MAX_EXTENT = 1e-100, 1e100
+#: a cell whose measure is below this fraction of h^d (h its longest edge) is
+#: collapsed: its stiffness is singular
+COLLAPSED = 1e-12
+
+
+def _check_geometry(name, points, cells, local):
+    """The nodes used by cells finite, the mesh's extent between MIN_EXTENT
+    and MAX_EXTENT, no collapsed cell (``local``: ``cells`` numbered into
+    ``points``)."""
+    bad = ~np.isfinite(points).all(axis=0)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise MeshFileError(f"{name!r} has a node that is not finite: "
+                            f"({', '.join(f'{c:g}' for c in points[:, i])})")
+    extent = float(np.ptp(points, axis=1).max()) if points.size else 0.0
+    if not MIN_EXTENT <= extent <= MAX_EXTENT:
+        raise MeshFileError(f"{name!r} spans {extent:g}; a mesh must span between "
+                            f"{MIN_EXTENT:g} and {MAX_EXTENT:g} (its cells' areas and "
+                            "volumes would under- or overflow): scale its coordinates")
+    x = points[:, local]                       # (d, d+1, nt)
+    edges = x[:, 1:, :] - x[:, :1, :]          # (d, d, nt)
+    measure = np.abs(np.linalg.det(np.moveaxis(edges, -1, 0)))   # d! |cell|
+    longest = np.zeros(local.shape[1])
+    for a in range(local.shape[0]):
+        for b in range(a + 1, local.shape[0]):
+            longest = np.maximum(longest, np.linalg.norm(x[:, a] - x[:, b], axis=0))
+    collapsed = measure <= COLLAPSED * longest ** points.shape[0]
+    if collapsed.any():
+        c = int(np.flatnonzero(collapsed)[0])
+        corners = "; ".join("(" + ", ".join(f"{v:.6g}" for v in x[:, a, c]) + ")"
+                            for a in range(local.shape[0]))
+        what = "area" if points.shape[0] == 2 else "volume"
+        raise MeshFileError(f"{name!r} has {int(collapsed.sum())} collapsed "
+                            f"{CELL[points.shape[0]]} cells (zero {what}), the first with "
+                            f"corners {corners}")
+
+
 def read_mesh_file(path, dim):
     """The scikit-fem mesh of a mesh file, its boundary groups named.
 
@@ -124,8 +173,12 @@ def read_mesh_file(path, dim):
     raw = _read(path)
     p = _points(raw, dim, name)
     t = _cells(raw, dim, name)
+    if t.size and (t.min() < 0 or t.max() >= p.shape[1]):
+        raise MeshFileError(f"{name!r} has cells with node numbers outside its "
+                            f"{p.shape[1]} nodes")
     groups = _facet_groups(raw, dim)
     used = np.unique(t)
+    _check_geometry(name, p[:, used], t, np.searchsorted(used, t))
     renumber = np.full(p.shape[1], -1)
     renumber[used] = np.arange(used.size)
     # C-ordered arrays: scikit-fem copies others and says so on stderr
