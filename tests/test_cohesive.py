@@ -182,3 +182,22 @@ def test_cohesive_needs_both_tables_and_the_explicit_update():
     with pytest.raises(SceneError) as err:
         scene(COHESIVE, {"law": "cohesive", "integrator": "implicit"})
     assert err.value.key == "contact.bonding.integrator"
+
+
+def test_a_facet_with_unequal_openings_dissipates_the_toughness():
+    """Two points of one facet open at different rates (δ₂ = 3 δ₁ + δ_0, up to the cap L = δ_f):
+    the scheme's debonding energy Σ (β_{n−1} − β_n) K P_B δ²_{n−1}/2
+    (postprocess/energy.py below the cap) sums to G_c, because the update
+    is driven by the facet's r.m.s. opening."""
+    normal = bilinear()
+    law = CohesiveDamage(normal)
+    mean = lambda f: f.reshape(-1, 2).mean(axis=1)
+    d0 = SIGMA / K
+    beta, dissipated = np.ones(1), 0.0
+    for s in np.linspace(0, normal.L, 40001):
+        opening = np.array([s, min(3 * s + d0, normal.L)])
+        new = damage.advance(law, -opening, None, mean, beta)
+        dissipated += (beta - new)[0] * K * np.mean(opening ** 2) / 2
+        beta = new
+    assert beta[0] == 0.0
+    assert dissipated == pytest.approx(G1, rel=1e-3)

@@ -189,12 +189,11 @@ class CohesiveDamage:
     """The bonding law of the cohesive zone: β as irreversible damage,
     updated from the previous level as the explicit step (4.2) is,
 
-        β_n = min(β_{n−1}, β*(P_B δ_n(u_{n−1}), P_B δ_τ(u_{n−1}))),
+        β_n = min(β_{n−1}, β*((P_B δ_n²)^½, (P_B δ_τ²)^½)) at u_{n−1},
 
-    β* of the normal law (:meth:`CohesiveNormal.intact`) at the facet means
-    of the openings (one damage per facet, driven by its mean opening; β*
-    of each point averaged instead would dissipate more than G_c, by the
-    products of one point's damage and another's larger opening). β_{n−1} is the
+    β* of the normal law (:meth:`CohesiveNormal.intact`) at the facet's
+    root-mean-square openings (one damage per facet; see
+    :mod:`adhesive_contact.scheme.bonding.damage` for why r.m.s.). β_{n−1} is the
     history variable: β* decreases with the effective opening, so at a
     fixed mixity β_n = P_B β*(max_{j<n} δ_m,j) and unloading follows the
     damaged secant β K. β stays in [0, 1] for every k (no bound like the
