@@ -21,7 +21,8 @@ independence of the law, 2 %), and the glue's dissipated energy per unit
 of new crack area, Δ(dissipated.debonding)/Δ(∫(1 − β)) while the crack
 front moves from 12 to 16 (2 %).
 
-Writes ``dcb/dcb.csv`` (P against δ for both step counts and LEFM) and
+Writes ``dcb/dcb.csv`` (P against δ for both step counts and LEFM, 400
+levels of each) and
 ``dcb/dcb.png``; each run's numbers are kept in ``dcb/runs/`` (not
 recomputed).
 """
@@ -85,11 +86,16 @@ def run(steps=None, cells=None):
     fronts = [float(f[:, 0].max()) if f.shape[0] else A0 for f in debond_fronts(solution)]
     return {"steps": int(data["time"]["steps"]), "cells": data["mesh"]["cells"],
             "t": solution.t.tolist(), "delta": (OPENING * solution.t).tolist(),
-            "P": reactions(solution)[:, left, 1].tolist(),
-            "debonding": np.asarray(history.dissipated["debonding"]).tolist(),
-            "numerical": np.asarray(history.dissipated["numerical"]).tolist(),
-            "damage": np.asarray(damage).tolist(), "front": fronts,
+            "P": kept(reactions(solution)[:, left, 1]),
+            "debonding": kept(history.dissipated["debonding"]),
+            "numerical": kept(history.dissipated["numerical"]),
+            "damage": kept(damage), "front": kept(fronts),
             "warnings": solution_warnings(solution)}
+
+
+def kept(values, digits=9):
+    """A list of ``values`` to ``digits`` significant digits (the runs/ files)."""
+    return [float(f"{v:.{digits}g}") for v in np.asarray(values, dtype=float)]
 
 
 def energy_per_new_area(record, growth=GROWTH):
@@ -146,8 +152,9 @@ def main():
     EI, Gc, chi = constants(data)
     records = [cached(f"steps_{n}", lambda n=n: run(n)) for n in STEPS]
     rows = []
-    for rec in records:
-        for d, p, a in zip(rec["delta"], rec["P"], rec["front"]):
+    for rec in records:          # every level of 400 per run in the CSV
+        every = max(1, rec["steps"] // 400)
+        for d, p, a in list(zip(rec["delta"], rec["P"], rec["front"]))[::every]:
             rows.append((rec["steps"], d, p, float(lefm(np.array(d), EI, Gc, chi)), a))
     write_csv(HERE / "dcb.csv", ["steps", "opening", "P", "P_lefm", "front"], rows)
 
