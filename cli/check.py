@@ -52,7 +52,12 @@ def check(scene, resolved):
                   f"nodes, {problem.columns.size} contact unknowns"))
     click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}")
     click.echo(f"  estimate: {est.describe()}")
-    if problem.bonding is not None:
+    if getattr(problem.bonding, "rate_independent", False):
+        from adhesive_contact.problem.warnings import DAMAGE_DROP
+        click.echo("  damage update of the cohesive law: beta stays in [0, 1] for every k; "
+                   "its one-level lag is checked after the run (a warning when a facet "
+                   f"loses more than {DAMAGE_DROP:g} of its bond in one level)")
+    elif problem.bonding is not None:
         bound = problem.bonding.stable_step()
         click.echo(f"  explicit Euler bound of the bonding law: k <= {bound:.4g} "
                    f"(k = {parsed.k:.4g}: {'within' if parsed.k <= bound else 'beyond'}; "

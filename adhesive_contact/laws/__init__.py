@@ -29,18 +29,26 @@ One module per kind of law (:mod:`.normal`, :mod:`.friction`,
 :mod:`.bonding`). ``NORMAL_LAWS``, ``FRICTION_LAWS`` and ``BONDING_LAWS``
 map the scene's law names to the class and the parameters it takes, so
 that the scene reader validates a law without knowing it: a new law is a
-class in its module and one entry here.
+class in its module and one entry here. A parameter's constraint is
+"positive", "nonnegative" or "number" (a required number), the same with
+a trailing "?" (an optional number, absent: not passed), or a tuple of
+strings (a required choice).
+
+The cohesive law (:mod:`.cohesive`) is a normal law and a bonding law
+named together: its bonding law takes the normal law's parameters, and a
+mixed-mode one adds its tangential traction to the friction laws.
 """
 
 from .bonding import Fremond, truncate
+from .cohesive import SHAPES, CohesiveDamage, CohesiveNormal, CohesiveShear
 from .friction import (AdhesiveSpring, Coulomb, FrictionSum, PointBound, PowerLaw,
                        SlipWeakening, Tresca)
 from .normal import AdhesiveCompliance, NoNormalLaw, NormalCompliance, separation
 
 __all__ = ["NORMAL_LAWS", "FRICTION_LAWS", "BONDING_LAWS", "make_normal_law", "make_friction",
            "make_bonding", "Fremond", "AdhesiveSpring", "Coulomb", "FrictionSum", "PointBound",
-           "PowerLaw",
-           "SlipWeakening", "Tresca", "AdhesiveCompliance", "NoNormalLaw", "NormalCompliance",
+           "PowerLaw", "SlipWeakening", "Tresca", "CohesiveDamage", "CohesiveNormal",
+           "CohesiveShear", "AdhesiveCompliance", "NoNormalLaw", "NormalCompliance",
            "separation", "truncate"]
 
 NORMAL_LAWS = {
@@ -48,6 +56,10 @@ NORMAL_LAWS = {
     "compliance": (NormalCompliance, {"c": "positive"}),
     "adhesive_compliance": (AdhesiveCompliance,
                             {"c": "positive", "gamma": "nonnegative", "L": "positive"}),
+    "cohesive": (CohesiveNormal,
+                 {"shape": SHAPES, "strength": "positive", "toughness": "positive",
+                  "stiffness": "positive?", "toughness_shear": "positive?",
+                  "mixity": "positive?"}),
 }
 
 FRICTION_LAWS = {
@@ -63,6 +75,7 @@ BONDING_LAWS = {
     "none": (None, {}),
     "fremond": (Fremond, {"gamma_nu": "nonnegative", "gamma_tau": "nonnegative",
                           "eps_a": "nonnegative", "L": "positive"}),
+    "cohesive": (CohesiveDamage, {}),
 }
 
 
@@ -72,14 +85,20 @@ def make_normal_law(spec):
     return cls(**spec.params)
 
 
-def make_friction(specs):
-    """A FrictionSum of the scene's friction laws, or None without friction."""
+def make_friction(specs, normal=None):
+    """A FrictionSum of the scene's friction laws and, for a mixed-mode
+    cohesive ``normal`` law, its tangential traction; None without friction."""
     laws = tuple(FRICTION_LAWS[s.law][0](**s.params) for s in specs if s.law != "none")
+    if isinstance(normal, CohesiveNormal) and normal.mixed:
+        laws += (CohesiveShear(normal.K, normal.L),)
     return FrictionSum(laws) if laws else None
 
 
-def make_bonding(spec):
-    """The bonding law, or None when β is frozen."""
+def make_bonding(spec, normal=None):
+    """The bonding law, or None when β is frozen; the cohesive one is made
+    from the ``normal`` law."""
     if spec.law == "none":
         return None
+    if spec.law == "cohesive":
+        return CohesiveDamage(normal)
     return BONDING_LAWS[spec.law][0](**spec.params)

@@ -137,9 +137,9 @@ class ContactLaws:
 
 def contact_laws(scene):
     """The law objects of the scene's ``[contact]`` tables."""
-    return ContactLaws(make_normal_law(scene.contact.normal),
-                       make_friction(scene.contact.friction),
-                       make_bonding(scene.contact.bonding))
+    normal = make_normal_law(scene.contact.normal)
+    return ContactLaws(normal, make_friction(scene.contact.friction, normal),
+                       make_bonding(scene.contact.bonding, normal))
 
 
 # ---------------------------------------------------------------- 4. manufactured solution

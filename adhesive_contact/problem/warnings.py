@@ -181,6 +181,40 @@ def explicit_bound_warning(problem):
             f"(docs/conventions.md#the-explicit-euler-bound-on-the-time-step)")
 
 
+#: a rate-independent damage update warns when a facet loses more than this
+#: fraction of its bond in one level
+DAMAGE_DROP = 0.1
+
+
+def damage_lag_warning(solution):
+    """A line when the damage update of a rate-independent bonding law (the
+    cohesive one) lost more than DAMAGE_DROP of a facet's bond in one level.
+
+    The update β_n = min(β_{n−1}, β*(u_{n−1})) lags the opening by one
+    level: β_n ∈ [0, 1] for every k, but level n's traction β_{n−1} K δ_n
+    exceeds the envelope by up to β_{n−1} K (δ_n − δ_{n−1}), and the glue's
+    dissipation exceeds G_c by a fraction that falls with the largest drop
+    max_{n,f} (β_{n−1,f} − β_{n,f}) (first order in k). ``solution.beta``
+    is (levels, nf)."""
+    problem = solution.problem
+    if not getattr(problem.bonding, "rate_independent", False):
+        return None
+    beta = np.asarray(solution.beta)
+    if beta.shape[0] < 2 or not beta.shape[1]:
+        return None
+    drop = beta[:-1] - beta[1:]
+    worst = float(drop.max())
+    if worst <= DAMAGE_DROP:
+        return None
+    steps = tuple(int(n) for n in np.flatnonzero(drop.max(axis=1) > DAMAGE_DROP) + 1)
+    need = int(np.ceil(problem.scene.steps * worst / DAMAGE_DROP))
+    return (f"the cohesive damage update lags the opening by one level and lost up to "
+            f"{worst:.2g} of a facet's bond in one level at {step_list(steps, solution.t)}, "
+            f"so the peak traction is overshot and the glue dissipates more than the "
+            f"toughness (first order in k): use at least time.steps = {need} for drops "
+            f"below {DAMAGE_DROP:g} (docs/model.md#44-the-cohesive-law-law--cohesive-in-both-tables)")
+
+
 def stiffness_warning(problem):
     """A line when the normal compliance stiffness c times the body's size
     lies more than STIFFNESS_ORDERS orders of magnitude from E."""
@@ -210,4 +244,5 @@ def problem_warnings(problem):
 def solution_warnings(solution):
     """The lines of the checks of a finished run that apply."""
     return [w for w in (nonconvex_step_warning(solution), two_solutions_warning(solution),
-                        geometry_warning(solution)) if w is not None]
+                        geometry_warning(solution), damage_lag_warning(solution))
+            if w is not None]

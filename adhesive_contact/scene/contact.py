@@ -36,6 +36,14 @@ def read_contact(table, dim, contact_sides):
         raise SceneError(table.key("friction"), "law 'coulomb' has the bound μ p_ν(β, u_ν) "
                          "of the normal law: it needs [contact.normal] law 'compliance' or "
                          f"'adhesive_compliance', got {normal.law!r}")
+    cohesive = (normal.law == "cohesive", bonding.law == "cohesive")
+    if any(cohesive) and not all(cohesive):
+        which = "bonding" if cohesive[0] else "normal"
+        raise SceneError(table.key(which) + ".law", "must be 'cohesive' too: the cohesive "
+                         "law names [contact.normal] and [contact.bonding] together")
+    if bonding.law == "cohesive" and integrator != "explicit":
+        raise SceneError(table.key("bonding") + ".integrator", "must be 'explicit' for the "
+                         "cohesive law (its damage update is not an ODE)")
     kinked = [f.law for f in friction if FRICTION_LAWS[f.law][0].has_kink]
     if quadrature == "gauss" and kinked:
         smooth = ", ".join(name for name, (cls, _) in FRICTION_LAWS.items()
@@ -88,12 +96,24 @@ def _read_bonding(table, dim):
 
 def _law(table):
     """A LawSpec of the registry the table's law key names (law name ->
-    (class, {parameter: "positive" or "nonnegative"}))."""
+    (class, {parameter: constraint}), the constraints of
+    :mod:`adhesive_contact.laws`)."""
     name = table.read("law")
     registry = declared(table.key("law")).laws
     params = {}
     for pname, constraint in registry[name][1].items():
-        params[pname] = within(table.key(pname), table.get(pname, "number"), constraint)
+        if isinstance(constraint, tuple):      # a string among choices
+            value = table.get(pname, "str")
+            if value not in constraint:
+                raise SceneError(table.key(pname), f"must be one of "
+                                 f"{', '.join(repr(c) for c in constraint)}, got {show(value)}")
+            params[pname] = value
+        elif constraint.endswith("?"):         # an optional number
+            value = table.get(pname, "number", required=False)
+            if value is not None:
+                params[pname] = within(table.key(pname), value, constraint[:-1])
+        else:
+            params[pname] = within(table.key(pname), table.get(pname, "number"), constraint)
     check = getattr(registry[name][0], "check", None)
     problem = check(params) if check else None
     if problem:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .bonding import FacetRate, advance
+from .bonding import FacetRate, advance, damage
 from .contact_energy import ContactEnergy
 from ..expressions import coordinates
 from ..step_methods import MAX_ITERATIONS, Kink, StepOptions, minimise
@@ -249,13 +249,16 @@ def bonding_step(problem, state):
     """(4.2): β_n from β_{n−1} and u_{n−1} by the scene's integrator
     (:mod:`adhesive_contact.scheme.bonding`); explicit Euler, the paper's, is
     β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
-    without a bonding law, and at n = 0)."""
+    without a bonding law, and at n = 0); a rate-independent law's damage
+    update (:mod:`adhesive_contact.scheme.bonding.damage`) in its place."""
     if problem.bonding is None or state.n < 0:
         return state.beta
     boundary = problem.boundary
     r = boundary.normal_trace @ state.frame_u
     xi = (np.stack([t @ state.frame_u for t in boundary.tangential_trace], axis=-1)
           if boundary.tangential_trace else None)
+    if getattr(problem.bonding, "rate_independent", False):
+        return damage.advance(problem.bonding, r, xi, boundary.facet_mean, state.beta)
     source = None
     if problem.beta_source is not None:   # manufactured solutions only
         source = problem.beta_source(*coordinates(boundary.points), t=state.t)

@@ -17,6 +17,9 @@ derivative ∂f/∂β (nf,), ≤ 0 for the Frémond law. Chosen by the scene's
 - ``"exponential"`` (:mod:`.exponential`): exponential Euler,
   β_n = β + k φ₁(k f'(β)) f(β), exact for a linear rate; keeps β in [0, 1].
 
+A rate-independent law (the cohesive one) has no rate: its damage update,
+:mod:`.damage`, takes the place of the integrator.
+
 All three are first order in k at frozen displacement (tests/test_integrators.py).
 """
 
@@ -24,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import explicit, exponential, implicit
+from . import damage, explicit, exponential, implicit
 
 #: contact.bonding.integrator -> module whose ``advance`` it calls
 INTEGRATORS = {"explicit": explicit, "implicit": implicit, "exponential": exponential}
