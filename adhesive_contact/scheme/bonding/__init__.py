@@ -17,17 +17,23 @@ derivative ∂f/∂β (nf,), ≤ 0 for the Frémond law. Chosen by the scene's
 - ``"exponential"`` (:mod:`.exponential`): exponential Euler,
   β_n = β + k φ₁(k f'(β)) f(β), exact for a linear rate; keeps β in [0, 1].
 
-All three are first order in k at frozen displacement (tests/test_integrators.py).
+- ``"midpoint"`` (:mod:`.midpoint`): the exponential midpoint rule, second
+  order; the integrator of ``time.scheme = "second-order"``, which freezes
+  the rate at the midpoint t_{n−½}; keeps β in [0, 1].
+
+The first three are first order in k at frozen displacement, the last
+second order (tests/test_integrators.py, tests/test_second_order.py).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import explicit, exponential, implicit
+from . import explicit, exponential, implicit, midpoint
 
 #: contact.bonding.integrator -> module whose ``advance`` it calls
-INTEGRATORS = {"explicit": explicit, "implicit": implicit, "exponential": exponential}
+INTEGRATORS = {"explicit": explicit, "implicit": implicit, "exponential": exponential,
+               "midpoint": midpoint}
 
 
 @dataclass
