@@ -21,8 +21,12 @@ derivative ∂f/∂β (nf,), ≤ 0 for the Frémond law. Chosen by the scene's
   order; the integrator of ``time.scheme = "second-order"``, which freezes
   the rate at the midpoint t_{n−½}; keeps β in [0, 1].
 
-The first three are first order in k at frozen displacement, the last
-second order (tests/test_integrators.py, tests/test_second_order.py).
+Explicit and implicit Euler are first order in k at frozen displacement;
+exponential Euler, with the exact ∂f/∂β, is exact for a linear rate and
+second order for a smooth one there, but the paper's scheme freezes the
+rate at t_{n−1}, which makes a run first order; the midpoint rule is second
+order at frozen displacement (tests/test_integrators.py,
+tests/test_second_order.py) and, with the rate frozen at t_{n−½}, in a run.
 """
 
 from dataclasses import dataclass
