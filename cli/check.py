@@ -34,7 +34,8 @@ def check(scene, resolved):
                + ("no contact boundary" if boundary is None else
                   f"{boundary.facets.size} contact facets, {boundary.nodes.size} contact "
                   f"nodes, {problem.columns.size} contact unknowns"))
-    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}")
+    scheme = "" if parsed.scheme == "paper" else f" ({parsed.scheme} scheme)"
+    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}{scheme}")
     click.echo(f"  estimate: {est.describe()}")
     if problem.bonding is not None:
         bound = problem.bonding.stable_step()

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import prony, run, scene_dict
+from conftest import assert_refused, prony, run, scene_dict, solve_scene
 from scipy.integrate import solve_ivp
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
@@ -270,6 +270,17 @@ def test_second_order_refuses_a_first_order_integrator():
     del data["contact"]["bonding"]["integrator"]
     assert scene_from_dict(data).contact.integrator == "midpoint"
     assert scene_from_dict(scene_a(steps=4)).contact.integrator == "explicit"
+
+
+def test_cli_refuses_a_bad_scheme_and_a_first_order_integrator_in_one_line(tmp_path):
+    (tmp_path / "a").mkdir(), (tmp_path / "b").mkdir()
+    data = scene_a(steps=4, scheme="third-order")
+    result, out = solve_scene(tmp_path / "a", data)
+    assert_refused(result, out, "time.scheme: must be one of 'paper', 'second-order'")
+    data = scene_a(steps=4, scheme="second-order")
+    data["contact"]["bonding"]["integrator"] = "exponential"
+    result, out = solve_scene(tmp_path / "b", data)
+    assert_refused(result, out, "contact.bonding.integrator: time.scheme = \"second-order\"")
 
 
 # --------------------------------------------------------------------------
