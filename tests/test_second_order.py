@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import assert_refused, prony, run, scene_dict, solve_scene
+from conftest import DELETE, assert_refused, prony, run, scene_dict, solve_scene
 from scipy.integrate import solve_ivp
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
@@ -301,3 +301,44 @@ def test_k_study_second_order_where_the_paper_is_first_order():
     assert np.all(np.abs(rates(paper) - 1.0) < 0.15)
     # rates 2 and 1: the ratio of the errors halves a level (1.3, 0.6, 0.3 here)
     assert second[-1] < 0.5 * paper[-1]
+
+
+# --------------------------------------------------------------------------
+# Relaxation at a held strain: the trapezoid's closed form
+# --------------------------------------------------------------------------
+#
+# A standard linear solid E(t) = E_∞ + E_1 e^{−t/τ} (ν = 0) stretched at t = 0
+# to a strain ε held for ever: σ(t) = E(t) ε. With c = k/τ and u_n = u_0 the
+# trapezoidal rule gives σ_n/ε = E_0 − E_1 c [½ e^{−nc} + Σ_{i=1}^{n−1} e^{−ic}
+# + ½], which tends to E_∞ − E_1 ((c/2) coth(c/2) − 1): 2.1 % of E_∞ too low
+# at k/τ = 0.5 (the paper's rule: E_1 (c/(1 − e^{−c}) − 1), 27 %).
+
+E_INF, E_1, STRAIN = 500.0, 500.0, 0.001
+
+
+def relaxation_stress(steps, T, scheme):
+    _, sol = run(scene_dict({
+        "mesh.size": [4.0, 1.0], "mesh.cells": [4, 1],
+        "boundary": {"dirichlet": [], "displacement": {
+            "left": ["0", "free"], "right": [repr(4.0 * STRAIN), "free"],
+            "bottom": ["free", "0"]}},
+        "material": DELETE,
+        "memory": {"kernel": "relaxation", "long_term": {"E": E_INF, "nu": 0.0},
+                   "terms": [{"E": E_1, "tau": 1.0}]},
+        "time": {"T": T, "steps": steps, "scheme": scheme}}))
+    return sol.stress[:, :, 0, 0].mean(axis=1)   # uniform: σ_xx in every cell
+
+
+def test_relaxation_at_a_held_strain_follows_the_trapezoid_closed_form():
+    c, steps = 0.5, 40   # k/τ = 0.5 to T = 20 τ
+    sigma = relaxation_stress(steps, c * steps, "second-order")
+    n = np.arange(1, steps + 1)
+    sums = np.array([np.exp(-c * np.arange(1, m)).sum() for m in n])
+    closed = (E_INF + E_1) - E_1 * c * (0.5 * np.exp(-n * c) + sums + 0.5)
+    # Tolerance: round-off of P1 solves on a uniform field (as test_scheme_memory)
+    np.testing.assert_allclose(sigma[1:] / STRAIN, closed, rtol=1e-10)
+    limit = E_INF - E_1 * (0.5 * c / np.tanh(0.5 * c) - 1.0)
+    assert abs(sigma[-1] / STRAIN - limit) < 1e-6 * E_INF      # e^{−20} of the way left
+    assert 0.019 < 1.0 - limit / E_INF < 0.022                 # 2.1 % at k/τ = 0.5
+    paper = relaxation_stress(steps, c * steps, "paper")[-1] / STRAIN
+    assert 0.26 < 1.0 - paper / E_INF < 0.28                   # 27 %
