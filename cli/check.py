@@ -50,7 +50,8 @@ def check(scene, resolved):
                + ("no contact boundary" if boundary is None else
                   f"{boundary.facets.size} contact facets, {boundary.nodes.size} contact "
                   f"nodes, {problem.columns.size} contact unknowns"))
-    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}")
+    scheme = "" if parsed.scheme == "paper" else f" ({parsed.scheme} scheme)"
+    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}{scheme}")
     click.echo(f"  estimate: {est.describe()}")
     if getattr(problem.bonding, "rate_independent", False):
         from adhesive_contact.problem.warnings import DAMAGE_DROP

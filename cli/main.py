@@ -237,7 +237,8 @@ def solve_command(scene, out, force, quiet):
     click.echo(f"{parsed.title}")
     click.echo(f"  mesh: {mesh.p.shape[1]} nodes, {mesh.t.shape[1]} cells, "
                f"{problem.ndofs} dofs ({problem.free.size} free), {contact}")
-    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}, "
+    scheme = "" if parsed.scheme == "paper" else f" ({parsed.scheme} scheme)"
+    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}{scheme}, "
                f"{int(solution.iterations.sum())} solver iterations, "
                f"{solution.timings['total']:.2f} s")
     if boundary is not None and boundary.facets.size:

@@ -88,7 +88,8 @@ def test_each_integrator_keeps_beta_in_the_unit_interval_or_says_it_cannot(name)
     """One step with k s = 3 (three times the explicit bound)."""
     rate = one_facet([3.0, 3.0], 0.0)
     beta = advance(name, rate, np.array([1.0]), 1.0)[0]
-    expected = {"explicit": 1.0 - 3.0, "implicit": 1.0 / 4.0, "exponential": np.exp(-3.0)}
+    expected = {"explicit": 1.0 - 3.0, "implicit": 1.0 / 4.0, "exponential": np.exp(-3.0),
+                "midpoint": np.exp(-3.0)}   # both exact for a linear rate
     assert beta == pytest.approx(expected[name], rel=1e-14)
 
 
@@ -162,5 +163,5 @@ def test_the_explicit_failure_names_the_other_integrators():
 def test_an_unknown_integrator_is_refused_naming_the_allowed():
     data = frozen(2, "rk4")
     with pytest.raises(SceneError, match=r"^contact\.bonding\.integrator: must be one of "
-                                         r"'explicit', 'implicit', 'exponential', got 'rk4'"):
+                                         r"'explicit', 'implicit', 'exponential', 'midpoint', got 'rk4'"):
         scene_from_dict(data)

@@ -109,6 +109,10 @@ def energy_unavailable(problem):
                 "energy balance does not hold")
     if memory is None:
         return None
+    if problem.scene.scheme == "second-order":
+        return ("the discrete energy balance is that of the paper's right rectangle rule; "
+                "the second-order scheme's trapezoidal memory has none here "
+                "(use time.scheme = \"paper\")")
     if memory.kernel == "function":
         return ("a general memory kernel r(t) has no free energy with nonnegative "
                 "dissipation (use kernel = \"relaxation\")")

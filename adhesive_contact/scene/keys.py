@@ -212,6 +212,9 @@ _DECLARATIONS = (
     Key("time.T", "number", REQUIRED, "the final time", bounds="positive"),
     Key("time.steps", "int", REQUIRED, "the number N of time steps, k = T/N",
         bounds=Interval(1, 10**8)),
+    Key("time.scheme", "str", "paper", "the time discretisation: the paper's (right "
+        "rectangle memory, first order) or the second-order one (trapezoidal memory, "
+        "exponential midpoint bonding)", choices=("paper", "second-order")),
 
     Key("solver.method", "str", "newton", "the step method", choices=tuple(STEP_METHODS)),
     Key("solver.tol", "number", 1e-10, "the step's residual, relative to its force scale",

@@ -9,6 +9,7 @@ names that a mesh file does not have) are made when the problem is built.
 """
 
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 from .contact import read_contact
@@ -47,7 +48,8 @@ def scene_from_dict(data, base_dir=None):
         material = read_material(top.table("material"), dim)
     body, traction = read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)
     contact = read_contact(top.table("contact"), dim, contact_sides)
-    T, steps = read_time(top.table("time"))
+    T, steps, scheme = read_time(top.table("time"))
+    contact = scheme_integrator(contact, scheme, data)
     solver = read_solver(top.table("solver"))
     probes, units, plot_times = read_output(top.table("output"), dim, T)
     exact = read_exact(top.table("exact"), dim, contact, top.has("loads"))
@@ -56,9 +58,29 @@ def scene_from_dict(data, base_dir=None):
         check_relaxation_step(memory, dim, T / steps)
     scene = Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
                   traction, contact, T, steps, solver, probes, exact, displacement, units,
-                  plot_times)
+                  plot_times, scheme)
     check_something_holds(scene, by_file)
     return scene
+
+
+#: the bonding integrator of the second-order scheme (docs/scheme.md)
+SECOND_ORDER_INTEGRATOR = "midpoint"
+
+
+def scheme_integrator(contact, scheme, data):
+    """``contact`` with the bonding integrator of ``scheme``: the second-order
+    scheme integrates β by the exponential midpoint rule (its default there);
+    a first-order integrator named with it is refused."""
+    if scheme != "second-order":
+        return contact
+    bonding = (data.get("contact") or {}).get("bonding") or {}
+    given = bonding.get("integrator") if isinstance(bonding, dict) else None
+    if given is not None and given != SECOND_ORDER_INTEGRATOR:
+        raise SceneError("contact.bonding.integrator",
+                         f"time.scheme = \"second-order\" integrates β by the exponential "
+                         f"midpoint rule: give \"{SECOND_ORDER_INTEGRATOR}\" or leave the key "
+                         f"out, got {given!r} (first order)")
+    return replace(contact, integrator=SECOND_ORDER_INTEGRATOR)
 
 
 def parse_scene(text, base_dir=None):

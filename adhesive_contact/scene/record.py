@@ -27,7 +27,9 @@ def resolved(scene):
         "loads": {"body": _texts(scene.body),
                   "traction": {side: _texts(v) for side, v in scene.traction.items()}},
         "contact": _contact_record(scene.contact),
-        "time": {"T": scene.T, "steps": scene.steps, "k": scene.k},
+        "time": {"T": scene.T, "steps": scene.steps, "k": scene.k,
+                 # only when not the paper's: a study recorded before the key resumes
+                 **({"scheme": scene.scheme} if scene.scheme != "paper" else {})},
         "solver": _solver_record(scene.solver),
         "output": {"probes": [list(p) for p in scene.probes],
                    **({"units": dict(scene.units)} if scene.units else {}),

@@ -202,6 +202,7 @@ class Scene:
     displacement: dict = field(default_factory=dict)  # side -> d Expressions or None ("free")
     units: dict = field(default_factory=dict)  # quantity -> unit name ([output] units)
     plot_times: object = "auto"   # the figures' times: "auto" or a sorted tuple
+    scheme: str = default("time.scheme")   # "paper" or "second-order" (docs/scheme.md)
 
     @property
     def held_sides(self):

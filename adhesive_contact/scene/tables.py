@@ -231,11 +231,12 @@ def read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
 
 
 def read_time(table):
-    """(T, steps)."""
+    """(T, steps, scheme)."""
     T = table.read("T")
     steps = table.read("steps")
+    scheme = table.read("scheme")
     table.finish()
-    return T, steps
+    return T, steps, scheme
 
 
 def read_solver(table):

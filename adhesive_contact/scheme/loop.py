@@ -6,6 +6,11 @@ by the scene's integrator (:mod:`.bonding`: explicit Euler as in the paper,
 implicit or exponential), gives β_n from level n − 1; u_n minimises the step energy with the
 step matrix A + k R(0), the load f(t_n) minus the memory history (right
 rectangle rule), the contact terms with β_n and the wall u_ν ≤ g(t_n).
+
+With ``time.scheme = "second-order"`` the memory is the trapezoidal rule
+(step matrix A + (k/2) R(0)) and β_n the exponential midpoint step with
+the rate at t_{n−½} (:func:`.state.bonding_step`); the contact step is the
+same, at t_n.
 """
 
 import time
@@ -93,10 +98,10 @@ def march(problem, operators, contact, recorder, state, progress=None):
         if failure is not None:
             return STEP_FAILED, failure, state
         recorder.record(level)
-        if n >= 1:
-            state.memory.advance(n, u)
+        state.memory.advance(n, u)   # u_0 only for the trapezoidal rule
         state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=state.memory,
-                      z_before=state.z if n >= 1 else None)
+                      z_before=state.z if n >= 1 else None,
+                      frame_u_before=state.frame_u if n >= 1 else None)
         if progress is not None and progress(n, problem.scene.steps) is True:
             return (STOPPED if n < problem.scene.steps else SUCCESS), None, state
     return SUCCESS, None, state

@@ -15,8 +15,15 @@ tr ε(a_λ) I + 2 ε(a_μ) (see :mod:`adhesive_contact.fem.assembly`).
 - A scalar kernel R(t) = r(t) C_0: the history k Σ_{j<n} r(t_n − t_j) u_j
   is summed directly, O(n) per step.
 
+With ``trapezoid=True`` (``time.scheme = "second-order"``) the rule is the
+trapezoidal one, k [½ R(t_n) ε(u_0) + Σ_{j=1}^{n−1} R(t_n − t_j) ε(u_j)
++ ½ R(0) ε(u_n)]: the j = n weight k/2 joins the step matrix (A + (k/2) R(0)),
+u_0 enters the history with weight k/2 (for Prony h_1^m = e^{−k/τ_m} (k/2) u_0,
+then the same recursion), second order in k for a smooth strain.
+
 Each object keeps the state of one run: ``begin(k, ndofs)``, then per step
-``history(n)`` before solving for u_n and ``advance(n, u_n)`` after.
+``history(n)`` before solving for u_n and ``advance(n, u_n)`` after (n ≥ 0;
+the rectangle rule ignores u_0).
 """
 
 import numpy as np
@@ -47,13 +54,15 @@ class PronyMemory:
 
     active = True
 
-    def __init__(self, lam, mu, tau):
+    def __init__(self, lam, mu, tau, trapezoid=False):
         self.lam = np.asarray(lam, dtype=float)
         self.mu = np.asarray(mu, dtype=float)
         self.tau = np.asarray(tau, dtype=float)
+        self.trapezoid = trapezoid
 
     def instantaneous(self, k):
-        return k * self.lam.sum(), k * self.mu.sum()
+        w = 0.5 * k if self.trapezoid else k   # the weight of j = n
+        return w * self.lam.sum(), w * self.mu.sum()
 
     def begin(self, k, ndofs):
         self.k = k
@@ -65,8 +74,13 @@ class PronyMemory:
         return self.lam @ self.h, self.mu @ self.h
 
     def advance(self, n, u):
-        """h_{n+1}^m = e^{−k/τ_m} (h_n^m + k u_n)."""
-        self.h += self.k * u[None, :]
+        """h_{n+1}^m = e^{−k/τ_m} (h_n^m + w_n k u_n), w_0 = ½ (trapezoid) or 0."""
+        if n == 0:
+            if not self.trapezoid:
+                return
+            self.h += (0.5 * self.k) * u[None, :]
+        else:
+            self.h += self.k * u[None, :]
         self.h *= self.decay[:, None]
 
 
@@ -75,10 +89,11 @@ class FunctionMemory:
 
     active = True
 
-    def __init__(self, r, lam, mu):
+    def __init__(self, r, lam, mu, trapezoid=False):
         self.r = r
         self.lam = lam
         self.mu = mu
+        self.trapezoid = trapezoid
 
     def _r(self, t):
         t = np.atleast_1d(np.asarray(t, dtype=float))
@@ -86,35 +101,47 @@ class FunctionMemory:
 
     def instantaneous(self, k):
         r0 = float(self._r(0.0)[0])
-        return k * r0 * self.lam, k * r0 * self.mu
+        w = 0.5 * k if self.trapezoid else k   # the weight of j = n
+        return w * r0 * self.lam, w * r0 * self.mu
 
     def begin(self, k, ndofs):
         self.k = k
         self.u = []  # u_1, u_2, ...
+        self.u0 = None   # u_0 (trapezoid only)
 
     def history(self, n):
-        if n == 1:
+        a = None
+        if n > 1:
+            lags = self.k * (n - np.arange(1, n))  # t_n − t_j, j = 1..n−1
+            a = self.k * (self._r(lags) @ np.asarray(self.u))
+        if self.u0 is not None:   # the trapezoid's ½ k r(t_n) u_0
+            end = (0.5 * self.k * float(self._r(n * self.k)[0])) * self.u0
+            a = end if a is None else a + end
+        if a is None:
             return None
-        lags = self.k * (n - np.arange(1, n))  # t_n − t_j, j = 1..n−1
-        a = self.k * (self._r(lags) @ np.asarray(self.u))
         return self.lam * a, self.mu * a
 
     def advance(self, n, u):
+        if n == 0:
+            if self.trapezoid:
+                self.u0 = u.copy()
+            return
         self.u.append(u.copy())
 
 
-def make_memory(spec):
-    """The memory object of a scene's MemorySpec (None: no memory)."""
+def make_memory(spec, trapezoid=False):
+    """The memory object of a scene's MemorySpec (None: no memory); the
+    trapezoidal rule with ``trapezoid``, else the right rectangle rule."""
     if spec is None:
         return NoMemory()
     if spec.kernel in ("prony", "relaxation"):   # relaxation: C_m = −C_i/τ_i
         terms = spec.prony_terms
         return PronyMemory([t.tensor.lam for t in terms], [t.tensor.mu for t in terms],
-                           [t.tau for t in terms])
-    return FunctionMemory(spec.function, spec.tensor.lam, spec.tensor.mu)
+                           [t.tau for t in terms], trapezoid)
+    return FunctionMemory(spec.function, spec.tensor.lam, spec.tensor.mu, trapezoid)
 
 
 def start_memory(problem):
-    """A fresh memory history for one run of ``problem`` (the rectangle
-    rule's state): a Problem is never changed by a run."""
-    return make_memory(problem.scene.memory)
+    """A fresh memory history for one run of ``problem`` (the rule of its
+    ``time.scheme``): a Problem is never changed by a run."""
+    return make_memory(problem.scene.memory, problem.scene.scheme == "second-order")

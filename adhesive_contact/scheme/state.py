@@ -31,6 +31,7 @@ class State:
                          # held ones included
     memory: object       # the run's memory history (adhesive_contact.scheme.memory)
     z_before: np.ndarray = None   # the step's unknowns of level n − 1 (None before level 1)
+    frame_u_before: np.ndarray = None   # frame_u of level n − 1 (None before level 1)
 
 
 @dataclass
@@ -250,18 +251,28 @@ def bonding_step(problem, state):
     (:mod:`adhesive_contact.scheme.bonding`); explicit Euler, the paper's, is
     β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
     without a bonding law, and at n = 0); a rate-independent law's damage
-    update (:mod:`adhesive_contact.scheme.bonding.damage`) in its place."""
+    update (:mod:`adhesive_contact.scheme.bonding.damage`) in its place.
+
+    The second-order scheme freezes the rate at the midpoint t_{n−½}: the
+    displacement extrapolated there, u_{n−½} ≈ (3 u_{n−1} − u_{n−2})/2
+    (u_0 itself for n = 1: one step's O(k²) error), the source s_β(t_{n−½});
+    its integrator (exponential midpoint) is second order in that rate."""
     if problem.bonding is None or state.n < 0:
         return state.beta
     boundary = problem.boundary
-    r = boundary.normal_trace @ state.frame_u
-    xi = (np.stack([t @ state.frame_u for t in boundary.tangential_trace], axis=-1)
+    frame_u, t = state.frame_u, state.t
+    if problem.scene.scheme == "second-order":
+        t = state.t + 0.5 * problem.scene.k
+        if state.frame_u_before is not None:
+            frame_u = 1.5 * state.frame_u - 0.5 * state.frame_u_before
+    r = boundary.normal_trace @ frame_u
+    xi = (np.stack([trace @ frame_u for trace in boundary.tangential_trace], axis=-1)
           if boundary.tangential_trace else None)
     if getattr(problem.bonding, "rate_independent", False):
         return damage.advance(problem.bonding, r, xi, boundary.facet_mean, state.beta)
     source = None
     if problem.beta_source is not None:   # manufactured solutions only
-        source = problem.beta_source(*coordinates(boundary.points), t=state.t)
+        source = problem.beta_source(*coordinates(boundary.points), t=t)
     rate = FacetRate(problem.bonding, r, xi, boundary.at_points, boundary.facet_mean, source)
     return advance(problem.scene.contact.integrator, rate, state.beta, problem.scene.k)
 

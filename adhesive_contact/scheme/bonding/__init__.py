@@ -15,22 +15,31 @@ derivative ∂f/∂β (nf,), ≤ 0 for the Frémond law. Chosen by the scene's
 - ``"implicit"`` (:mod:`.implicit`): backward Euler in β, β_n = β + k f(β_n),
   with the displacement of level n − 1 (semi-implicit, see the module);
 - ``"exponential"`` (:mod:`.exponential`): exponential Euler,
-  β_n = β + k φ₁(k f'(β)) f(β), exact for a linear rate; keeps β in [0, 1].
+  β_n = β + k φ₁(k f'(β)) f(β), exact for a linear rate; keeps β in [0, 1];
+- ``"midpoint"`` (:mod:`.midpoint`): the exponential midpoint rule, second
+  order; the integrator of ``time.scheme = "second-order"``, which freezes
+  the rate at the midpoint t_{n−½}; keeps β in [0, 1].
+
+Explicit and implicit Euler are first order in k at frozen displacement;
+exponential Euler, with the exact ∂f/∂β, is exact for a linear rate and
+second order for a smooth one there, but the paper's scheme freezes the
+rate at t_{n−1}, which makes a run first order; the midpoint rule is second
+order at frozen displacement (tests/test_integrators.py,
+tests/test_second_order.py) and, with the rate frozen at t_{n−½}, in a run.
 
 A rate-independent law (the cohesive one) has no rate: its damage update,
 :mod:`.damage`, takes the place of the integrator.
-
-All three are first order in k at frozen displacement (tests/test_integrators.py).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import damage, explicit, exponential, implicit
+from . import damage, explicit, exponential, implicit, midpoint
 
 #: contact.bonding.integrator -> module whose ``advance`` it calls
-INTEGRATORS = {"explicit": explicit, "implicit": implicit, "exponential": exponential}
+INTEGRATORS = {"explicit": explicit, "implicit": implicit, "exponential": exponential,
+               "midpoint": midpoint}
 
 
 @dataclass
