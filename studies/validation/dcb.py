@@ -27,11 +27,12 @@ levels of each) and
 recomputed).
 """
 
-import json
 import tomllib
 from pathlib import Path
 
 import numpy as np
+
+from adhesive_contact.storage import read_json, write_atomic, write_json
 
 HERE = Path(__file__).resolve().parent / "dcb"
 E, NU, H, A0, OPENING = 1000.0, 0.3, 1.0, 10.0, 1.6
@@ -126,23 +127,21 @@ def summary(record, data):
 
 
 def cached(name, compute, folder=HERE / "runs"):
-    folder.mkdir(parents=True, exist_ok=True)
+    """The record ``name`` of ``folder``: read back if a run saved it, else
+    computed and saved whole (a killed run leaves no half record)."""
     path = folder / f"{name}.json"
     if path.exists():
-        return json.loads(path.read_text())
+        return read_json(path)
+    folder.mkdir(parents=True, exist_ok=True)
     record = compute()
-    partial = path.with_suffix(".partial")
-    partial.write_text(json.dumps(record))
-    partial.replace(path)
+    write_json(path, record)
     return record
 
 
 def write_csv(path, header, rows):
-    partial = path.with_suffix(".partial")
     lines = [",".join(header)] + [",".join(f"{v:.10g}" if isinstance(v, float) else str(v)
                                            for v in row) for row in rows]
-    partial.write_text("\n".join(lines) + "\n")
-    partial.replace(path)
+    write_atomic(path, lambda f: f.write("\n".join(lines) + "\n"))
 
 
 def main():
