@@ -244,3 +244,22 @@ def test_a_uniform_mixed_separation_dissipates_the_bk_toughness():
     """Top moved at 45°: B = ½ at the interface up to the block's own
     deformation, G_c(½) = 0.02 + 0.03 · ½² = 0.0275 (BK, η = 2); within 2 %."""
     assert uniform_separation(["0.1*t", "0.1*t"], 800) == pytest.approx(0.0275, rel=0.02)
+
+
+def test_the_second_order_scheme_refuses_the_cohesive_law():
+    """Its damage update follows the previous level (first order): the
+    second-order scheme would not be second order with it."""
+    from adhesive_contact import SceneError, scene_from_dict
+
+    data = {"dim": 2, "mesh": {"domain": "rectangle", "size": [2.0, 0.5], "cells": [8, 2]},
+            "boundary": {"dirichlet": ["left"], "contact": ["bottom"]},
+            "material": {"E": 1000.0, "nu": 0.3},
+            "contact": {"normal": {"law": "cohesive", "shape": "bilinear", "strength": 1.0,
+                                   "toughness": 0.01, "stiffness": 1000.0},
+                        "bonding": {"law": "cohesive"}},
+            "time": {"T": 1.0, "steps": 4, "scheme": "second-order"}}
+    with pytest.raises(SceneError, match=r"^time\.scheme: \"second-order\" has no "
+                                         r"second-order update for the cohesive law"):
+        scene_from_dict(data)
+    data["time"]["scheme"] = "paper"
+    assert scene_from_dict(data).contact.bonding.law == "cohesive"

@@ -73,6 +73,10 @@ def scheme_integrator(contact, scheme, data):
     a first-order integrator named with it is refused."""
     if scheme != "second-order":
         return contact
+    if contact.bonding.law == "cohesive":
+        raise SceneError("time.scheme", "\"second-order\" has no second-order update for "
+                         "the cohesive law (its damage follows the previous level: first "
+                         "order); use \"paper\"")
     bonding = (data.get("contact") or {}).get("bonding") or {}
     given = bonding.get("integrator") if isinstance(bonding, dict) else None
     if given is not None and given != SECOND_ORDER_INTEGRATOR:
