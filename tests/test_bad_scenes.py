@@ -172,3 +172,12 @@ def test_a_foundation_point_too_far_out_is_refused(tmp_path):
         "shape": "sphere", "point": [1.0, -1e200], "radius": 1.0}}, COMPLIANT_BLOCK))
     assert_refused(result, out, "contact.foundation.point: [1.0, -1e+200] is too far out "
                    "(each coordinate at most 1e+100 in absolute value)")
+
+
+def test_a_cell_count_too_large_for_a_float_is_one_line(tmp_path):
+    # TOML reads a 400-digit integer exactly; its count of nodes overflowed
+    # float formatting (an OverflowError traceback)
+    result, out = solve_scene(tmp_path, scene_dict({"mesh.cells": [2, int("9" * 400)]},
+                                                   COMPLIANT_BLOCK))
+    assert_refused(result, out, "mesh.cells: gives about 1e+400 nodes after 0 refinements; "
+                   "at most 1e+08 are allowed")

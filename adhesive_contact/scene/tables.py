@@ -55,9 +55,10 @@ def _cell_counts(key, size, cells, refine, pattern):
     anyway, and the memory check needs a count it can estimate from), and
     cells no more elongated than MAX_CELL_ASPECT (their stiffness would be
     nearly singular)."""
-    nodes = nodes_of(cells, refine, pattern)
+    nodes = nodes_of(cells, refine, pattern)   # a Python int: exact, however large
     if nodes > MAX_NODES:
-        raise SceneError(key, f"gives {nodes:.3g} nodes after {refine} refinements; at most "
+        shown = f"{nodes:.3g}" if nodes < 10**300 else f"about 1e+{len(str(nodes)) - 1}"
+        raise SceneError(key, f"gives {shown} nodes after {refine} refinements; at most "
                          f"{MAX_NODES:.0e} are allowed")
     edges = [s / c for s, c in zip(size, cells)]
     if max(edges) > MAX_CELL_ASPECT * min(edges):
