@@ -136,6 +136,29 @@ def read_json(path):
         return None
 
 
+def saved_or_computed(path, compute):
+    """The JSON record at ``path`` when a run saved it, else ``compute()``
+    saved there whole (:func:`write_json`: a killed run leaves no half
+    record) and returned: how a study script resumes."""
+    record = read_json(path)
+    if record is not None:
+        return record
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    record = compute()
+    write_json(path, record)
+    return record
+
+
+def write_csv(path, header, rows, digits=10):
+    """A CSV table written atomically: the ``header`` row, then ``rows``
+    (sequences of values; floats to ``digits`` significant digits)."""
+    lines = [",".join(header)] + [
+        ",".join(f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row)
+        for row in rows]
+    text = "\n".join(lines) + "\n"
+    write_atomic(path, lambda f: f.write(text))
+
+
 def toml_value(value):
     """A value as it is written in TOML (``1000.0``, ``true``, ``"gauss"``)."""
     if isinstance(value, bool):

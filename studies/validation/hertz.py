@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from adhesive_contact import build_problem, scene_from_dict, solve
+from adhesive_contact.storage import write_csv
 
 HERE = Path(__file__).resolve().parent
 GEOMETRIES = ("disc", "block")
@@ -140,16 +141,6 @@ def run(geometry, level, folder):
     return records
 
 
-def write_csv(rows, path):
-    lines = [",".join(COLUMNS)]
-    for r in rows:
-        lines.append(",".join(f"{r[c]:.6g}" if isinstance(r[c], float) else str(r[c])
-                              for c in COLUMNS))
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    tmp.replace(path)
-
-
 def plot(rows, path):
     import matplotlib
     matplotlib.use("Agg")
@@ -198,7 +189,8 @@ def main(argv=None):
                       f"a/R = {r['a_over_R']:.4f}: a {100 * r['err_a']:+.3f} %, "
                       f"p0 {100 * r['err_p0']:+.3f} %, profile {100 * r['err_profile']:.2f} % "
                       f"(P1 floor {100 * r['floor_profile']:.2f} %), {r['seconds']:.1f} s")
-    write_csv(rows, args.folder / "hertz.csv")
+    write_csv(args.folder / "hertz.csv", COLUMNS, [[r[c] for c in COLUMNS] for r in rows],
+              digits=6)
     plot(rows, args.folder / "hertz.png")
 
 

@@ -33,13 +33,13 @@ Writes ``lee_radok/creep.csv``, ``lee_radok/relaxation.csv`` and
 """
 
 import argparse
-import csv
-import json
 import math
 import tomllib
 from pathlib import Path
 
 import numpy as np
+
+from adhesive_contact.storage import saved_or_computed, write_csv
 
 HERE = Path(__file__).resolve().parent / "lee_radok"
 E_INF, E_1, TAU, NU, R = 500.0, 500.0, 1.0, 0.3, 1.0
@@ -147,17 +147,8 @@ def run_relaxation(steps, mesh=MESH):
 
 
 def cached(kind, steps, compute, folder=HERE / "runs"):
-    """A run's record, from ``runs/`` or computed and kept there (written
-    whole: a file that exists is complete)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{kind}_{steps}.json"
-    if path.exists():
-        return json.loads(path.read_text())
-    record = compute(steps)
-    partial = path.with_suffix(".partial")
-    partial.write_text(json.dumps(record))
-    partial.replace(path)
-    return record
+    """A run's record, from ``runs/`` or computed and kept there."""
+    return saved_or_computed(folder / f"{kind}_{steps}.json", lambda: compute(steps))
 
 
 def creep_rows(records):
@@ -193,15 +184,9 @@ def relaxation_rows(records):
     return rows
 
 
-def write_csv(path, rows):
-    partial = path.with_suffix(".partial")
-    with open(partial, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]), lineterminator="\n")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({key: (f"{value:.8g}" if isinstance(value, float) else value)
-                             for key, value in row.items()})
-    partial.replace(path)
+def write_table(path, rows):
+    """``rows`` (dicts of one set of keys) as a CSV table, 8 digits."""
+    write_csv(path, list(rows[0]), [list(row.values()) for row in rows], digits=8)
 
 
 def figure(creep, relaxation, path):
@@ -245,8 +230,8 @@ def main():
     args = parser.parse_args()
     creep = [cached("creep", n, run_creep) for n in args.steps]
     relaxation = [cached("relaxation", n, run_relaxation) for n in args.steps]
-    write_csv(HERE / "creep.csv", creep_rows(creep))
-    write_csv(HERE / "relaxation.csv", relaxation_rows(relaxation))
+    write_table(HERE / "creep.csv", creep_rows(creep))
+    write_table(HERE / "relaxation.csv", relaxation_rows(relaxation))
     figure(creep, relaxation, HERE / "lee_radok.png")
     for row in creep_rows(creep):
         print(f"creep steps {row['steps']:4d} t = {row['t']:4.2f}: a = {row['a']:.5f} "

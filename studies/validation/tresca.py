@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from adhesive_contact.storage import read_json, write_atomic, write_json
+from adhesive_contact.storage import saved_or_computed, write_csv
 
 HERE = Path(__file__).resolve().parent / "tresca"
 MU_BLOCK, MU_STRIP, LENGTH, THICKNESS = 2.0, 1.0, 10.0, 0.5
@@ -85,21 +85,8 @@ def run_strip(cells):
 
 
 def cached(name, compute, folder=HERE / "runs"):
-    """The record ``name`` of ``folder``: read back if a run saved it, else
-    computed and saved whole (a killed run leaves no half record)."""
-    path = folder / f"{name}.json"
-    if path.exists():
-        return read_json(path)
-    folder.mkdir(parents=True, exist_ok=True)
-    record = compute()
-    write_json(path, record)
-    return record
-
-
-def write_csv(path, header, rows):
-    lines = [",".join(header)] + [",".join(f"{v:.10g}" if isinstance(v, float) else str(v)
-                                           for v in row) for row in rows]
-    write_atomic(path, lambda f: f.write("\n".join(lines) + "\n"))
+    """The record ``name`` of ``folder``, computed only when no run saved it."""
+    return saved_or_computed(folder / f"{name}.json", compute)
 
 
 def main():
