@@ -282,3 +282,27 @@ def assert_refused(result, out, needle):
     assert result.exit_code == 2, (result.stderr, result.exception)
     assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
     assert not out.exists()
+
+
+@pytest.fixture
+def counting(monkeypatch):
+    """Count the calls of run_level (by level) and run_reference that a
+    convergence study makes (adhesive_contact.studies.convergence)."""
+    from types import SimpleNamespace
+
+    import adhesive_contact.studies.convergence as converge_module
+
+    calls = SimpleNamespace(levels=[], reference=0)
+    real_level, real_reference = converge_module.run_level, converge_module.run_reference
+
+    def run_level(scene, param, level, reference=None, **kwargs):
+        calls.levels.append(level)
+        return real_level(scene, param, level, reference, **kwargs)
+
+    def run_reference(*args, **kwargs):
+        calls.reference += 1
+        return real_reference(*args, **kwargs)
+
+    monkeypatch.setattr(converge_module, "run_level", run_level)
+    monkeypatch.setattr(converge_module, "run_reference", run_reference)
+    return calls

@@ -92,25 +92,6 @@ def fine_study(scenes, tmp_path_factory):
     return SimpleNamespace(out=out, result=result)
 
 
-@pytest.fixture
-def counting(monkeypatch):
-    """Count the calls of run_level (by level) and run_reference made by the CLI."""
-    calls = SimpleNamespace(levels=[], reference=0)
-    real_level, real_reference = converge_module.run_level, converge_module.run_reference
-
-    def run_level(scene, param, level, reference=None, **kwargs):
-        calls.levels.append(level)
-        return real_level(scene, param, level, reference, **kwargs)
-
-    def run_reference(*args, **kwargs):
-        calls.reference += 1
-        return real_reference(*args, **kwargs)
-
-    monkeypatch.setattr(converge_module, "run_level", run_level)
-    monkeypatch.setattr(converge_module, "run_reference", run_reference)
-    return calls
-
-
 # ---------------------------------------------------------------- (1) exact
 
 

@@ -13,7 +13,6 @@ import pytest
 from adhesive_contact_cli.main import main
 from conftest import assert_one_line_error, law, prony, runner, scene_dict, to_toml
 
-import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import parse_scene
 from adhesive_contact.fem.meshes import mesh_size
 from adhesive_contact.postprocess import reaction_sides, reactions
@@ -50,24 +49,6 @@ def study(scene_file, tmp_path_factory):
     result = run(scene_file, *ARGS, "--out", out)
     assert result.exit_code == 0, (result.stdout, result.stderr)
     return SimpleNamespace(out=out, result=result)
-
-
-@pytest.fixture
-def counting(monkeypatch):
-    calls = SimpleNamespace(levels=[], reference=0)
-    real_level, real_reference = converge_module.run_level, converge_module.run_reference
-
-    def run_level(scene, param, level, reference=None, **kwargs):
-        calls.levels.append(level)
-        return real_level(scene, param, level, reference, **kwargs)
-
-    def run_reference(*args, **kwargs):
-        calls.reference += 1
-        return real_reference(*args, **kwargs)
-
-    monkeypatch.setattr(converge_module, "run_level", run_level)
-    monkeypatch.setattr(converge_module, "run_reference", run_reference)
-    return calls
 
 
 def top_y_peak(scene):
