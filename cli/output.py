@@ -25,8 +25,9 @@ from pathlib import Path
 
 from adhesive_contact.folders import staged_folder
 from adhesive_contact.io import write_npz, write_xdmf
-from adhesive_contact.resources import estimate
+from adhesive_contact.postprocess import energies
 from adhesive_contact.problem.warnings import solution_warnings
+from adhesive_contact.resources import estimate
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, read_json, write_json
 from adhesive_contact.visuals import PLOT_NAMES, write_plots
@@ -38,7 +39,7 @@ from .summary import energy_record, smallness_record, step_records
 SCHEMA = 1
 
 
-def summary(solution, source=None):
+def summary(solution, source=None, history=None):
     """The ``summary.json`` document (a dict of plain JSON types).
 
     ``source``: ``{"text", "folder"}``, the scene's TOML text and the
@@ -67,7 +68,7 @@ def summary(solution, source=None):
         "resources": resources_record(solution),
         "iterations": [int(i) for i in solution.iterations],
         "energy": energy_record(solution),
-        "steps": step_records(solution),
+        "steps": step_records(solution, history),
     }
 
 
@@ -103,9 +104,9 @@ def run_record(solution):
     }
 
 
-def write_summary(solution, path, source=None):
+def write_summary(solution, path, source=None, history=None):
     """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
-    write_json(path, summary(solution, source))
+    write_json(path, summary(solution, source, history))
 
 
 #: every file name ``adhcontact solve`` may write; in an existing folder a
@@ -153,9 +154,10 @@ def write_results(solution, folder, failures=None, source=None):
     list), if given; the data files are written all the same. ``source``:
     the scene's text and folder (:func:`summary`)."""
     folder = Path(folder)
-    write_summary(solution, folder / "summary.json", source)
+    history = energies(solution)   # once, for summary.json and the figures
+    write_summary(solution, folder / "summary.json", source, history)
     write_npz(solution, folder / "solution.npz")
-    return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures)
+    return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures, history)
 
 
 def write_outputs(solution, out, failures=None, source=None):

@@ -77,7 +77,7 @@ def _count(values, n):
     return None if values is None else int(values[n])
 
 
-def step_records(solution):
+def step_records(solution, history=None):
     """The per-level entries of ``summary.json``'s ``steps`` list.
 
     Each is ``{"t", "probes", "normal_force", "tangential_force", "beta_mean",
@@ -112,7 +112,7 @@ def step_records(solution):
     has_nodes = boundary is not None and boundary.nodes.size > 0
     contact = total_contact_force(solution) if has_nodes else None
     in_contact = contact_measure(solution) if has_nodes else None
-    history = energies(solution)
+    history = energies(solution) if history is None else history
     debonding = None
     if boundary is not None and boundary.facets.size:
         area, damage = debonded_area(solution)

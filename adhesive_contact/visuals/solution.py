@@ -18,7 +18,7 @@ PLOT_NAMES = ("deformed", "contact_traction", "beta", "contact_map", "load_displ
               "energy", "debonding")
 
 
-def write_plots(solution, folder, failures=None):
+def write_plots(solution, folder, failures=None, history=None):
     """Draw the figures of a solution into ``folder``; return the names of
     the files written.
 
@@ -29,7 +29,8 @@ def write_plots(solution, folder, failures=None):
     ``debonding.png`` with contact facets and a bonding law. A scene without contact facets skips the contact
     figures (not an error). A figure that cannot be drawn is left out and,
     when ``failures`` is a list, named there with the reason: the plots must
-    never cost the run's data.
+    never cost the run's data. ``history``: the run's
+    :func:`~adhesive_contact.postprocess.energies`, when the caller has it.
 
     Parameters
     ----------
@@ -57,7 +58,7 @@ def write_plots(solution, folder, failures=None):
     if curves:
         plots.append(("load_displacement.png",
                       lambda solution, path: plot_load_displacement(solution, path, curves)))
-    history = energies(solution)
+    history = energies(solution) if history is None else history
     if history is not None:
         plots.append(("energy.png", lambda solution, path: plot_energy(solution, path, history)))
     if (boundary is not None and boundary.facets.size
