@@ -562,6 +562,31 @@ def test_a_part_of_the_mesh_held_by_no_side_is_refused(tmp_path):
     assert build_problem(scene_from_dict(file_scene(tmp_path / "m.msh"))).free.size
 
 
+def test_the_contact_terms_hold_a_part_of_the_mesh_on_its_own(tmp_path):
+    """Two strips in one file, only the first hung from its top, both on a
+    compliant foot: the layer holds the second strip's vertical translation
+    and rotation but not its slide along x, which is refused naming that
+    part; with Tresca friction on the foot as well, nothing is free."""
+    from skfem import MeshTri
+
+    a = strip_mesh()
+    both = MeshTri(np.hstack([a.p, a.p + np.array([[3.0], [0.0]])]),
+                   np.hstack([a.t, a.t + a.p.shape[1]]))
+    both = both.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0) & (x[0] < 2.5),
+                                 "foot": lambda x: np.isclose(x[1], 0.0)})
+    write_msh(tmp_path / "m.msh", both, ["top", "foot"])
+    layer = {"contact.normal": law("compliance", c=100.0)}
+    with pytest.raises(SceneError, match=r"^boundary: the part of the mesh around \(4, 0\.5\) "
+                                         r"\(15 nodes, not connected to the rest\): the held "
+                                         r"sides \(top\) and the contact terms on Γ_C \(a normal "
+                                         r"law\) leave the body free to move rigidly "
+                                         r"\(translation along x\)"):
+        build_problem(scene_from_dict(file_scene(tmp_path / "m.msh", layer)))
+    held = build_problem(scene_from_dict(file_scene(
+        tmp_path / "m.msh", {**layer, "contact.friction": law("tresca", mu=1.0)})))
+    assert held.free.size
+
+
 @pytest.mark.parametrize("content, needle", [
     (b"$", "cannot read 'm.msh' as a mesh: meshio gave up on it (meshio: "),   # SystemExit
     (b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", "'m.msh' has no nodes"),      # IndexError

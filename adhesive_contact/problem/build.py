@@ -229,8 +229,9 @@ def restraint(scene, mesh, held, laws, on_contact):
     tangential = laws.friction is not None
     terms = [name for name, acts in (("a normal law", normal), ("a wall", wall.any()),
                                      ("friction", tangential)) if acts] or ["none"]
-    rows = restraining_rows(modes, boundary, normal, wall, tangential)
-    check_rigid_motions(mesh, fixed, sides, (rows, ", ".join(terms)))
+    check_rigid_motions(mesh, fixed, sides, (
+        lambda motions: restraining_rows(motions, boundary, normal, wall, tangential),
+        ", ".join(terms)))
     free = free_rigid_motions(modes, fixed)
     return tuple(describe_motions(free, mesh.p)) if free.shape[1] else ()
 

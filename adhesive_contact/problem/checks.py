@@ -270,27 +270,30 @@ def restraining_rows(modes, boundary, normal, wall, tangential):
 
 
 def check_rigid_motions(mesh, fixed, sides, contact=None):
-    """Refuse a scene that leaves a rigid motion of the body free (see
-    :func:`_check_motions`); a file mesh of several connected parts without
-    contact terms is checked part by part (a part no held side holds would
-    make the stiffness singular)."""
+    """Refuse a scene that leaves a rigid motion of a part of the body free
+    (:func:`_check_motions`), each connected part of the mesh on its own (a
+    file mesh may have several: one that nothing holds makes the stiffness
+    singular). ``contact``: (``rows``, the phrase naming the contact terms),
+    ``rows(modes)`` the rows through which the contact terms see the rigid
+    motions ``modes`` (:func:`restraining_rows`)."""
     parts = mesh_parts(mesh)
-    if contact is None and parts.max() > 0:
-        d = mesh.dim()
-        for part in range(parts.max() + 1):
-            nodes = np.flatnonzero(parts == part)
-            held = fixed[np.isin(fixed // d, nodes)]
-            try:
-                _check_motions(mesh.p[:, nodes],
-                               np.searchsorted(nodes, held // d) * d + held % d, sides)
-            except SceneError as err:
-                centre = mesh.p[:, nodes].mean(axis=1)
-                raise SceneError("boundary", f"the part of the mesh around "
-                                 f"{where(centre)} ({nodes.size} nodes, not connected to "
-                                 f"the rest): {str(err).removeprefix('boundary: ')}") \
-                    from None
+    if parts.max() == 0:
+        _check_motions(rigid_modes(mesh.p), mesh.p, fixed, sides, contact)
         return
-    _check_motions(mesh.p, fixed, sides, contact)
+    d = mesh.dim()
+    for part in range(parts.max() + 1):
+        nodes = np.flatnonzero(parts == part)
+        own = rigid_modes(mesh.p[:, nodes])                     # (len(nodes)·d, nmodes)
+        modes = np.zeros((mesh.p.shape[1], d, own.shape[1]))    # the part's motions, 0 elsewhere
+        modes[nodes] = own.reshape(nodes.size, d, -1)
+        try:
+            _check_motions(modes.reshape(-1, own.shape[1]), mesh.p[:, nodes], fixed, sides,
+                           contact)
+        except SceneError as err:
+            centre = mesh.p[:, nodes].mean(axis=1)
+            raise SceneError("boundary", f"the part of the mesh around {where(centre)} "
+                             f"({nodes.size} nodes, not connected to the rest): "
+                             f"{str(err).removeprefix('boundary: ')}") from None
 
 
 def mesh_parts(mesh):
@@ -305,17 +308,17 @@ def mesh_parts(mesh):
     return connected_components(graph, directed=False)[1]
 
 
-def _check_motions(points, fixed, sides, contact=None):
-    """Refuse a scene that leaves a rigid motion of the body free: one that
-    vanishes at the held dofs ``fixed`` and, with ``contact`` (the rows of
-    :func:`restraining_rows` and a phrase naming the contact terms), changes
-    none of the contact terms. The message lists exactly the motions left
-    free (:func:`describe_motions`)."""
-    modes = rigid_modes(points)
+def _check_motions(modes, points, fixed, sides, contact=None):
+    """Refuse a rigid motion among ``modes`` (of the body, or of one part at
+    ``points``) that vanishes at the held dofs ``fixed`` and, with
+    ``contact`` (see :func:`check_rigid_motions`), changes none of the
+    contact terms. The message lists exactly the motions left free
+    (:func:`describe_motions`)."""
     free = free_rigid_motions(modes, fixed)
     if contact is not None and free.shape[1]:
         rows, terms = contact
-        free = free @ _null_space(rows @ free, free.shape[1])
+        seen = rows(modes)
+        free = free @ _null_space(seen @ free, free.shape[1])
     if free.shape[1] == 0:
         return
     motions = describe_motions(free, points)
