@@ -2,11 +2,14 @@
 all four): the half-width and peak pressure against the closed form
 a = √(4PR/(πE*)), p0 = 2P/(πa) at the computed force P.
 
-Tolerances: at a/R ≈ 0.05 the study measures on this mesh −0.38 % (disc)
-and +0.48 % (block) in a, −2.6 % and −3.4 % in p0 (h_c/a = 0.1: p0 falls
-like h); the block's half-width keeps +0.5 % on every mesh, the O(a/R)
-term x·u_x that measuring along the cylinder's radial normal adds to the
-bound and that Hertz's theory drops. 1 % in a and 4 % in p0 hold both."""
+Tolerances: at a/R ≈ 0.05 (level 5 of 8) the study measures on this mesh
+(a/h_c ≈ 10, the lattice of hertz_meshes.py under the contact) −0.04 %
+(disc) and +0.61 % (block) in a, +0.00 % and −0.67 % in p0; on the finest
+mesh +0.53 % and −0.55 % remain for the block, the O(a/R) departure of
+the bound along the cylinder's radial normal (its x·u_x term) from Hertz's
+vertical one, which falls with a/R (+0.26 % at a/R ≈ 0.02). 0.8 % in a and
+1 % in p0 hold both with 0.15 % to spare; the unstructured rings meshes
+this replaced gave −3.4 % in p0 here."""
 
 import sys
 from pathlib import Path
@@ -24,10 +27,10 @@ import hertz  # noqa: E402
 def test_hertz_half_width_and_peak_pressure_on_the_coarse_mesh(geometry):
     problem = build_problem(hertz.scene(geometry, 0))
     solution = solve(problem, raise_on_failure=True)
-    r = hertz.measure(problem, solution, 1)
+    r = hertz.measure(problem, solution, 5)
     assert 0.045 < r["a_over_R"] < 0.06
-    assert abs(r["err_a"]) < 0.01
-    assert abs(r["err_p0"]) < 0.04
+    assert abs(r["err_a"]) < 0.008
+    assert abs(r["err_p0"]) < 0.01
     # Hertz's half-width lies within a mesh cell of the last node on the wall
     assert r["a_bracket_lo"] - 0.005 < r["a_hertz"] < r["a_bracket_hi"] + 0.005
     # the profile is as close as the P1 floor allows, within a factor 1.5

@@ -13,9 +13,10 @@ axis x = 0 held in x:
 - ``block`` (hertz_block.toml): a rigid cylinder of radius R = 1 (the
   foundation ``shape = "sphere"``) pressed into an elastic block 4 × 4.
 
-The indentation is driven by a prescribed approach δ(t) (four steps); at
-each level the computed total force P (twice the half model's) gives
-Hertz's half-width and peak pressure,
+The indentation is driven by a prescribed approach δ(t) = δ_1 t³ (eight
+steps); the levels t = 2/8, 3/8, 5/8, 1 (a/R ≈ 0.01, 0.02, 0.05, 0.1) are
+compared. At each the computed total force P (twice the half model's)
+gives Hertz's half-width and peak pressure,
 
     a = sqrt(4 P R / (π E*)),   p0 = 2 P / (π a),   p(x) = p0 sqrt(1 − x²/a²),
 
@@ -45,9 +46,10 @@ HERE = Path(__file__).resolve().parent
 GEOMETRIES = ("disc", "block")
 LEVELS = (0, 1, 2, 3)
 H_C = {0: 0.005, 1: 0.0025, 2: 0.00125, 3: 0.000625}
-COMPARED = (1, 4)             # the time levels compared: a/R ≈ 0.05 and ≈ 0.1
+COMPARED = (2, 3, 5, 8)       # the time levels compared: a/R ≈ 0.01, 0.02, 0.05, 0.1
+STEPS = 8
 R = 1.0
-COLUMNS = ("geometry", "mesh", "h_c", "dofs", "contact_nodes", "t", "delta", "P", "a_over_R",
+COLUMNS = ("geometry", "mesh", "h_c", "dofs", "contact_nodes", "level", "t", "delta", "P", "a_over_R",
            "a_hertz", "a_moment", "err_a", "p0_hertz", "p0", "err_p0", "err_profile",
            "floor_profile", "a_bracket_lo", "a_bracket_hi", "seconds")
 
@@ -132,7 +134,8 @@ def run(geometry, level, folder):
     delta = {"disc": 0.02, "block": 0.028}[geometry]
     records = [{"geometry": geometry, "mesh": level, "h_c": H_C[level],
                 "dofs": int(problem.ndofs), "contact_nodes": int(problem.boundary.nodes.size),
-                "delta": delta * float(solution.t[n]), **measure(problem, solution, n),
+                "level": n, "delta": delta * float(solution.t[n]) ** 3,
+                **measure(problem, solution, n),
                 "seconds": seconds} for n in COMPARED]
     folder.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp")
@@ -146,29 +149,45 @@ def plot(rows, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    fig, axes = plt.subplots(1, 4, figsize=(20, 4.6))
+    styles = dict(zip(COMPARED, (":", "-.", "--", "-")))
+    finest = max(r["mesh"] for r in rows)
     for geometry, marker in zip(GEOMETRIES, "os"):
-        for n, style in zip(COMPARED, ("--", "-")):
-            sel = [r for r in rows if r["geometry"] == geometry and r["t"] == n / 4]
+        for n in COMPARED:
+            sel = [r for r in rows if r["geometry"] == geometry and r["level"] == n]
             if not sel:
                 continue
             h = [r["h_c"] for r in sel]
             label = f"{geometry}, a/R = {sel[-1]['a_over_R']:.3f}"
+            style = styles[n]
             axes[0].loglog(h, [abs(r["err_a"]) for r in sel], style, marker=marker, label=label)
             axes[1].loglog(h, [abs(r["err_p0"]) for r in sel], style, marker=marker, label=label)
             axes[2].loglog(h, [r["err_profile"] for r in sel], style, marker=marker,
                            label=f"{label}: computed")
-            axes[2].loglog(h, [r["floor_profile"] for r in sel], ":", marker=marker,
-                           color=axes[2].lines[-1].get_color(), label=f"{label}: P1 floor")
+            axes[2].loglog(h, [r["floor_profile"] for r in sel], ":", marker=marker, lw=0.7,
+                           color=axes[2].lines[-1].get_color())
+        sel = [r for r in rows if r["geometry"] == geometry and r["mesh"] == finest]
+        aR = [r["a_over_R"] for r in sel]
+        axes[3].plot(aR, [100 * r["err_a"] for r in sel], "-", marker=marker,
+                     label=f"{geometry}: a")
+        axes[3].plot(aR, [100 * r["err_p0"] for r in sel], "--", marker=marker,
+                     label=f"{geometry}: p0")
     for ax, what in zip(axes, ("|a_h / a − 1| (moment half-width)", "|p_h(0) / p0 − 1|",
-                               "‖p_h − p‖ / ‖p‖ on Γ_C")):
+                               "‖p_h − p‖ / ‖p‖ on Γ_C (dotted: P1 floor)")):
         ax.set_xlabel("element size at the contact h_c")
         ax.set_title(what)
         ax.grid(True, which="both", alpha=0.3)
     axes[0].axhline(3e-3, color="k", lw=0.8)
     axes[1].axhline(5e-3, color="k", lw=0.8)
-    axes[0].legend(fontsize=7)
-    axes[2].legend(fontsize=6)
+    axes[0].legend(fontsize=6)
+    axes[2].legend(fontsize=5)
+    axes[3].axhspan(-0.3, 0.3, color="0.85", zorder=0)
+    axes[3].axhline(0.0, color="k", lw=0.6)
+    axes[3].set_xlabel("a / R")
+    axes[3].set_ylabel("error on the finest mesh, %")
+    axes[3].set_title("the departure from Hertz against a/R (band: 0.3 %)")
+    axes[3].grid(True, alpha=0.3)
+    axes[3].legend(fontsize=7)
     fig.suptitle("2D Hertz (plane strain, frictionless Signorini), error against the closed "
                  "form at the computed force P; lines: the goals 0.3 % and 0.5 %")
     fig.tight_layout()
