@@ -23,8 +23,8 @@ larger of its shear (μ) and bulk (κ = λ + 2μ/d) parts: the worst held
 strain. Numerator and denominator move apart with t, so T is the worst
 level. For a standard linear solid with E_1 = E_∞ and T ≫ τ, δ = e(c):
 27 % at k/τ = 0.5, 5.1 % at 0.1, 1 % at 0.02 for the paper's rule; 2.1 %,
-0.083 % and 0.0033 % for the trapezoid (measured by
-studies/stability/time_accuracy.py, which matches these to 1e-9). A
+0.083 % and 0.0033 % for the trapezoid (studies/stability/time_accuracy.py
+measures them; tests/test_accuracy_guides.py holds a run to δ to 1e-9). A
 ``function`` kernel r(t) C_0 gets the same δ with the rules' sums of r
 against ∫ r by a 4-point Gauss rule on each step, at every level.
 
