@@ -7,6 +7,19 @@ import numpy as np
 
 from .normal import separation
 
+#: what the integrators that keep β in [0, 1] at any k cost at a step beyond
+#: the law's time scale 1/((γ_ν + γ_τ) L²) (:meth:`Fremond.stable_step`),
+#: measured by studies/stability/time_accuracy.py (docs/scheme.md): (4.2)
+#: finds β_n from the displacement of the level before whatever the
+#: integrator, so the glue debonds a level late
+BEYOND_TIME_SCALE = (
+    "contact.bonding.integrator 'implicit', 'exponential' and 'midpoint' keep beta in "
+    "[0, 1] at any k, but beta_n follows the displacement of the level before, so at k "
+    "beyond that bound, the bonding law's time scale, the debonding front lags and the "
+    "force the glue carries is overstated (studies/scenes/peel.toml: "
+    "peak peel force +20 to +25 % at 1.5 times that scale, +91 to +105 % at 3 times, "
+    "against +16 % for explicit Euler at it)")
+
 
 def truncate(xi, L):
     """R_τ(ξ) = ξ if |ξ| ≤ L else L ξ/|ξ|, for ξ of shape (..., d−1)."""
@@ -59,7 +72,9 @@ class Fremond:
 
     def stable_step(self):
         """The largest k with β_n ≥ 0 guaranteed for explicit Euler:
-        k (γ_ν + γ_τ) L² ≤ 1 (β_n ≥ β_{n−1}(1 − k max stretch))."""
+        k (γ_ν + γ_τ) L² ≤ 1 (β_n ≥ β_{n−1}(1 − k max stretch)); the law's
+        time scale, the shortest time the glue takes to debond (beyond it
+        every integrator lags: :data:`BEYOND_TIME_SCALE`)."""
         worst = self.gamma_nu * (self.L * self.L) + self.gamma_tau * (self.L * self.L)
         return np.inf if worst == 0 else 1.0 / worst
 

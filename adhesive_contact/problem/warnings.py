@@ -2,7 +2,9 @@
 
 Nothing here raises (refusals are :mod:`.checks`). Before a run,
 :func:`problem_warnings` says what the scene's numbers make likely to go
-wrong: a step beyond the explicit Euler bound of the bonding law, and a
+wrong: a step beyond the explicit Euler bound of the bonding law, a step
+beyond an accuracy guide of :mod:`.accuracy` (the bonding law's time scale
+with another integrator, the memory's quadrature error), a
 contact stiffness many orders of magnitude away from the body's (the step
 matrix is then ill-conditioned, or the contact law irrelevant), and the
 material data the discretisation or physics cannot bear (:mod:`.plausibility`:
@@ -20,6 +22,9 @@ linear, small-strain model represents.
 
 import numpy as np
 
+from ..laws.bonding import BEYOND_TIME_SCALE
+from .accuracy import (MEMORY_GUIDE, bonding_time_scale, memory_error, shortest_relaxation_time,
+                       steps_for_memory, steps_for_time_scale)
 from .plausibility import plausibility_warnings
 
 #: the largest principal strain |ε| the small-strain model is taken to represent
@@ -176,9 +181,54 @@ def explicit_bound_warning(problem):
         return None
     return (f"the time step k = {scene.k:.4g} exceeds the explicit Euler bound "
             f"1/((gamma_nu + gamma_tau) L^2) = {problem.bonding.stable_step():.4g} of "
-            f"the bonding law, so beta may leave [0, 1] and the run stop: use more "
-            f"steps or another contact.bonding.integrator "
-            f"(docs/conventions.md#the-explicit-euler-bound-on-the-time-step)")
+            f"the bonding law, so beta may leave [0, 1] and the run stop: use at least "
+            f"time.steps = {steps_for_time_scale(problem)} or [time.adaptive] tol; "
+            f"{BEYOND_TIME_SCALE} "
+            f"(docs/scheme.md#accuracy-guides-of-the-time-step)")
+
+
+def time_scale_warning(problem):
+    """A line when an integrator other than explicit Euler (which has
+    :func:`explicit_bound_warning`) runs at a step beyond the bonding law's
+    time scale 1/((γ_ν + γ_τ) L²): stable, but the debonding front lags
+    (:mod:`.accuracy`)."""
+    scale = bonding_time_scale(problem)
+    scene = problem.scene
+    if scale is None or scene.contact.integrator == "explicit" or scene.k <= scale:
+        return None
+    return (f"the time step k = {scene.k:.4g} is {scene.k / scale:.3g} times the explicit "
+            f"Euler bound 1/((gamma_nu + gamma_tau) L^2) = {scale:.4g} of the bonding law: "
+            f"{BEYOND_TIME_SCALE}; use at least time.steps = "
+            f"{steps_for_time_scale(problem)}, or [time.adaptive] tol "
+            f"(docs/scheme.md#accuracy-guides-of-the-time-step)")
+
+
+#: the memory's quadrature rule by time.scheme
+MEMORY_RULES = {"paper": "right rectangle rule", "second-order": "trapezoidal rule"}
+
+
+def memory_step_warning(problem):
+    """A line when the memory's quadrature at the scene's k puts the stress
+    of a strain held from t = 0 off by more than MEMORY_GUIDE at T
+    (:func:`.accuracy.memory_error`)."""
+    scene = problem.scene
+    error = memory_error(scene)
+    if error is None or error <= MEMORY_GUIDE:
+        return None
+    tau = shortest_relaxation_time(scene)
+    ratio = "" if tau is None else f", k/tau = {scene.k / tau:.3g} for its shortest tau = {tau:.4g}"
+    need = steps_for_memory(scene)
+    advice = "" if need is None else f"use at least time.steps = {need}"
+    if scene.scheme == "paper" and scene.contact.bonding.law != "cohesive":
+        second = memory_error(scene, scheme="second-order")
+        advice += (f", or time.scheme = \"second-order\" ({100 * second:.2g} % at this k; "
+                   f"second order in k where the contact sets do not switch, not the "
+                   f"paper's scheme)")
+    return (f"the memory's {MEMORY_RULES[scene.scheme]} at k = {scene.k:.4g}{ratio} puts "
+            f"the stress of a strain held from t = 0 off by {100 * error:.2g} % at "
+            f"t = T, more than the guide's {100 * MEMORY_GUIDE:g} %"
+            + (f": {advice}" if advice else "")
+            + " (docs/scheme.md#accuracy-guides-of-the-time-step)")
 
 
 #: a rate-independent damage update warns when a facet loses more than this
@@ -237,6 +287,7 @@ def stiffness_warning(problem):
 def problem_warnings(problem):
     """The lines of the checks of a scene that apply, before a run."""
     return [w for w in (held_by_contact_warning(problem), explicit_bound_warning(problem),
+                        time_scale_warning(problem), memory_step_warning(problem),
                         stiffness_warning(problem))
             if w is not None] + plausibility_warnings(problem.scene)
 

@@ -22,6 +22,7 @@ says what failed, where, the figures and what to try.
 
 import numpy as np
 
+from ..laws.bonding import BEYOND_TIME_SCALE
 from ..scene.errors import where
 from ..step_methods import EXACT
 from .solution import StepFailure
@@ -77,8 +78,9 @@ def check_level(problem, level):
                        f"this run has k = {k:.4g}")
             if k > bound:
                 need = int(np.ceil(problem.scene.T / bound))
-                reason += (f". Use at least time.steps = {need}, or "
-                           f"contact.bonding.integrator = 'exponential' or 'implicit'")
+                reason += (f". Use at least time.steps = {need} or [time.adaptive] tol; "
+                           f"{BEYOND_TIME_SCALE} "
+                           f"(docs/scheme.md#accuracy-guides-of-the-time-step)")
         return InvalidState(n, t, reason)
     gap = problem.gap
     exact = problem.scene.solver.method in EXACT
