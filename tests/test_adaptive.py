@@ -21,9 +21,10 @@ from adhesive_contact.scheme.adaptive_memory import FunctionMemory, PronyMemory,
 
 
 def controller(halvings=6, steps=4, T=1.0, tol=1e-3, stable=math.inf, order=1):
+    # rate_floor 1 and no change given: q = err T / (tol 2h), the error per unit time
     scene = SimpleNamespace(T=T, steps=steps, k=T / steps, scheme="paper",
                             adaptive=SimpleNamespace(tol=tol, halvings=halvings, growth=2.0,
-                                                     shrink=0.25, safety=0.9))
+                                                     shrink=0.25, safety=0.9, rate_floor=1.0))
     c = Controller.of(scene, stable)
     c.order = order
     return c
@@ -81,6 +82,13 @@ def test_controller_forces_k_min_and_caps_at_the_explicit_bound():
     assert c.forced == len(accepted)
     accepted, _ = drive(controller(stable=0.1), lambda t, h: 0.0)   # always small
     assert min(j for _, j in accepted) == 3
+
+
+def test_the_tolerance_is_relative_to_the_change_of_the_pair():
+    c = controller(tol=0.01)
+    j = 4   # 2h = 1/32
+    assert c.ratio(1e-3, j, change=0.5) == pytest.approx(1e-3 / (0.01 * 0.5))
+    assert c.ratio(1e-3, j, change=0.0) == pytest.approx(1e-3 / (0.01 * 1.0 / 32))
 
 
 def test_the_last_pair_lands_on_T():

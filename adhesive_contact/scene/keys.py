@@ -219,9 +219,12 @@ _DECLARATIONS = (
     Key("time.adaptive", "table", None, "adaptive time steps by step doubling, k_max = T/N "
         "(uniform steps k = T/N when absent)"),
     # below 1e-8 the steps reach k_min everywhere; above 1 nothing is controlled
-    Key("time.adaptive.tol", "number", REQUIRED, "the local error allowed per unit time "
-        "(relative u plus β, per step of length k: err ≤ tol k/T)",
+    Key("time.adaptive.tol", "number", REQUIRED, "the local error of a pair of steps "
+        "allowed, relative to what the pair changes (u relative plus β rms)",
         bounds=Interval(1e-8, 1.0)),
+    Key("time.adaptive.rate_floor", "number", 1e-3, "the smallest change per unit time "
+        "the tolerance is relative to (a quiet stretch counts as changing at this rate)",
+        bounds="positive"),
     Key("time.adaptive.k_min", "number", None, "the smallest step (k_max/1024 when absent), "
         "rounded down to k_max 2^-J", bounds="positive"),
     Key("time.adaptive.growth", "number", 2.0, "the largest factor a step may grow by after "

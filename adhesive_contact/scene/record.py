@@ -42,7 +42,8 @@ def resolved(scene):
 
 
 def _adaptive_record(adaptive):
-    return {"tol": adaptive.tol, "k_min": adaptive.k_min, "halvings": adaptive.halvings,
+    return {"tol": adaptive.tol, "rate_floor": adaptive.rate_floor,
+            "k_min": adaptive.k_min, "halvings": adaptive.halvings,
             "growth": adaptive.growth, "shrink": adaptive.shrink, "safety": adaptive.safety}
 
 

@@ -188,6 +188,7 @@ class AdaptiveSpec:
     tol: float
     k_min: float            # k_max 2^-halvings (the given k_min rounded down)
     halvings: int           # J ≥ 1
+    rate_floor: float = default("time.adaptive.rate_floor")
     growth: float = default("time.adaptive.growth")
     shrink: float = default("time.adaptive.shrink")
     safety: float = default("time.adaptive.safety")

@@ -248,6 +248,7 @@ def read_adaptive(table, k_max):
     """``[time.adaptive]`` with k_max = T/N: k_min (default k_max/1024)
     rounded down to k_max 2^-J, 1 ≤ J ≤ MAX_HALVINGS."""
     tol = table.read("tol")
+    rate_floor = table.read("rate_floor")
     k_min = table.read("k_min")
     growth, shrink, safety = table.read("growth"), table.read("shrink"), table.read("safety")
     table.finish()
@@ -261,7 +262,8 @@ def read_adaptive(table, k_max):
         if halvings > MAX_HALVINGS:
             raise SceneError(table.key("k_min"), f"must be at least k_max 2^-{MAX_HALVINGS} = "
                              f"{k_max * 2.0 ** -MAX_HALVINGS:g}, got {k_min:g}")
-    return AdaptiveSpec(tol, k_max * 2.0 ** -halvings, halvings, growth, shrink, safety)
+    return AdaptiveSpec(tol, k_max * 2.0 ** -halvings, halvings, rate_floor, growth, shrink,
+                        safety)
 
 
 def read_solver(table):

@@ -13,15 +13,22 @@ from the one step 2h over the same interval (Richardson, scheme of order p),
     err = ‖y_{2×h} − y_{2h}‖ / (2^p − 1),   ‖y‖ = ‖u‖_2 / U + ‖β‖_{rms}
 
 with U the largest ‖u_n‖_2 so far (a relative displacement) and the rms of
-β weighted by the facet measures. The pair is accepted when its error
-per unit time is within the tolerance, q = err T / (2h tol) ≤ 1, or when
-h = k_min already; the next half step (after a rejection, the retried one) is
+β weighted by the facet measures. The tolerance is relative to what the
+pair changes, Δ = ‖y_{t+2h} − y_t‖ in the same norm, floored at
+``rate_floor`` 2h/T (a quiet stretch counts as changing at that rate): the
+pair is accepted when q = err / (tol max(Δ, rate_floor 2h/T)) ≤ 1, or when
+h = k_min already. This controls the local time lag err/|y'| of the
+pair rather than its error per unit time: an error made early in a
+debonding is carried to the end as a lag of the front, and the error of a
+lag grows with the front's speed (studies/convergence/adaptive). The next
+half step (after a rejection, the retried one) is
 
     h_new = h · min(growth, max(shrink, safety · q^{−1/p}))
 
 rounded down to the quantised set, capped at the explicit Euler bound of
 the bonding law (2h ≤ k_E, the doubled step included) and at what is left
-of [0, T]. With err ∝ h^{p+1}, q ∝ h^p: the exponent 1/p makes q ≈ safety^p.
+of [0, T]. With err ∝ h^{p+1} and Δ ∝ h, q ∝ h^p: the exponent 1/p makes
+q ≈ safety^p.
 """
 
 import math
@@ -78,7 +85,7 @@ class StepSizes:
 class Controller:
     """Accepts or rejects a pair of half steps and picks the next half step.
 
-    ``tol``, ``growth``, ``shrink``, ``safety`` of [time.adaptive], ``order``
+    ``tol``, ``rate_floor``, ``growth``, ``shrink``, ``safety`` of [time.adaptive], ``order``
     p of the scheme (1 the paper's, 2 the second-order one), ``T`` the final
     time. Counts ``accepted``, ``rejected`` and ``forced`` pairs (accepted
     at k_min with q > 1)."""
@@ -87,6 +94,7 @@ class Controller:
     tol: float
     T: float
     order: int = 1
+    rate_floor: float = 1e-3
     growth: float = 2.0
     shrink: float = 0.25
     safety: float = 0.9
@@ -98,11 +106,13 @@ class Controller:
     def of(cls, scene, stable_step=math.inf):
         a = scene.adaptive
         return cls(StepSizes.of(scene, stable_step), a.tol, scene.T,
-                   2 if scene.scheme == "second-order" else 1, a.growth, a.shrink, a.safety)
+                   2 if scene.scheme == "second-order" else 1, a.rate_floor, a.growth,
+                   a.shrink, a.safety)
 
-    def ratio(self, err, j):
-        """q = err / (tol 2h_j / T): the error per unit time over the tolerance."""
-        return err * self.T / (self.tol * 2.0 * self.sizes.size(j))
+    def ratio(self, err, j, change=0.0):
+        """q = err / (tol max(Δ, rate_floor 2h_j/T)), Δ = ``change`` of the pair."""
+        return err / (self.tol * max(change, self.rate_floor * 2.0 * self.sizes.size(j)
+                                     / self.T))
 
     def factor(self, q):
         """min(growth, max(shrink, safety q^{−1/p}))."""
@@ -110,11 +120,12 @@ class Controller:
             return self.growth
         return min(self.growth, max(self.shrink, self.safety * q ** (-1.0 / self.order)))
 
-    def judge(self, err, j, at):
+    def judge(self, err, j, at, change=0.0):
         """(accept, next j) for a pair of half steps h_j starting at unit
-        ``at`` with estimated error ``err``; the next j is that of the pair
-        after it (accepted: from ``at + 2 span(j)``) or of the retry."""
-        q = self.ratio(err, j)
+        ``at`` with estimated error ``err`` and change Δ = ``change``; the
+        next j is that of the pair after it (accepted: from ``at + 2
+        span(j)``) or of the retry."""
+        q = self.ratio(err, j, change)
         finite = math.isfinite(q)
         accept = (finite and q <= 1.0) or j == self.sizes.halvings
         target = self.sizes.size(j) * (self.factor(q) if finite else self.shrink)
@@ -145,6 +156,7 @@ class PairNorm:
         self.largest = max(self.largest, float(np.linalg.norm(u)))
 
     def __call__(self, du, dbeta, order=1):
+        # order=1: the norm itself (the pair's change Δ)
         """The Richardson estimate of the pair's error from the differences
         of the doubled step to the pair: (‖du‖/U + rms dβ) / (2^p − 1)."""
         eu = float(np.linalg.norm(du)) / self.largest if self.largest > 0 else 0.0

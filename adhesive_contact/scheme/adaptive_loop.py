@@ -174,7 +174,8 @@ class _Run:
             err = (math.inf if big is None else
                    self.norm(two[0].u - big[0].u, two[0].beta - big[0].beta,
                              self.controller.order))
-            accept, j_next = self.controller.judge(err, j, at)
+            change = self.norm(two[0].u - state.u, two[0].beta - state.beta)
+            accept, j_next = self.controller.judge(err, j, at, change)
             if not accept:
                 self.restore(notes)
                 j = j_next
