@@ -65,6 +65,9 @@ def summary(solution, source=None, history=None):
         "warnings": [str(w) for w in problem.warnings()] + solution_warnings(solution),
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
+        **({"adaptive": {key: json_number(v) if isinstance(v, float) else v
+                         for key, v in solution.adaptive.items()}}
+           if solution.adaptive is not None else {}),
         "resources": resources_record(solution),
         "iterations": [int(i) for i in solution.iterations],
         "energy": energy_record(solution),
@@ -96,7 +99,8 @@ def run_record(solution):
         "success": bool(solution.success),
         "status": {SUCCESS: "complete", STEP_FAILED: "step failed",
                    STOPPED: "interrupted"}[solution.status],
-        "partial": bool(solution.t.size < solution.problem.times.size),
+        "partial": bool(solution.t.size < solution.problem.times.size
+                        if solution.adaptive is None else not solution.success),
         "levels": int(solution.t.size),
         "message": " ".join(solution.message.split()),
         "failed_step": None if failure is None else int(failure.n),

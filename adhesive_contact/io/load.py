@@ -11,6 +11,7 @@ gives the problem); ``solution.npz`` gives every array
 
 import json
 import zipfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -212,6 +213,8 @@ def load_solution(folder, problem=None):
     if not np.array_equal(arrays["points"], problem.mesh.p.T):
         raise OutputFolderError(npz_path, "holds another mesh than the problem's")
     zz = arrays.get("stress_zz_last")
+    if problem.scene.adaptive is not None and problem.times.size != arrays["t"].size:
+        problem = on_levels(problem, arrays["t"])
     return Solution(
         problem=problem, status=STATUS[run["status"]], message=run["message"], failure=None,
         t=arrays["t"], u=arrays["u"], beta=arrays["beta"],
@@ -222,4 +225,13 @@ def load_solution(folder, problem=None):
         residual=arrays["residual"], reaction=arrays["held_reaction"],
         timings={k: (float("nan") if v is None else v)
                  for k, v in document.get("timings", {}).items()},
-        linear=dict(document.get("linear", {})))
+        linear=dict(document.get("linear", {})), adaptive=document.get("adaptive"))
+
+
+def on_levels(problem, t):
+    """An adaptive run's problem (built on the grid m k_min) with the times
+    ``t`` of its levels and their gaps, as the run returned it."""
+    k_min = problem.scene.adaptive.k_min
+    index = np.rint(np.asarray(t) / k_min).astype(np.int64)
+    return replace(problem, times=np.asarray(t, dtype=float).copy(),
+                   gap=None if problem.gap is None else np.ascontiguousarray(problem.gap[index]))

@@ -63,7 +63,8 @@ class StreamingRecorder:
         npoints, d = problem.mesh.p.shape[1], problem.dim
         self.scratch = H5File(self.folder / SCRATCH, "w")   # a full disk raises (h5.py)
         self.u = self.scratch.file.create_dataset("u", (levels, npoints, d), dtype=float,
-                                             chunks=(1, npoints, d))
+                                             chunks=(1, npoints, d),
+                                             maxshape=(None, npoints, d))
         self.small = {name: [] for name in SMALL}
         self.last = None
         self.count = 0
@@ -72,6 +73,8 @@ class StreamingRecorder:
     def record(self, level):
         """Write level ``level.n`` and keep its small fields."""
         self.series.write(level)
+        if level.n >= self.u.shape[0]:   # an adaptive run: more levels than N + 1
+            self.u.resize(2 * self.u.shape[0], axis=0)
         self.u[level.n] = level.u
         for name in SMALL:
             self.small[name].append(np.asarray(getattr(level, name)))

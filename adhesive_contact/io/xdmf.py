@@ -134,7 +134,9 @@ class XdmfSeries:
         """The contact fields of a level at the points of ``contact.xdmf``
         (every vertex of Γ_C is a contact node; the force is 0 along a
         held component, being in the side's reaction)."""
-        gap = None if self.problem.gap is None else self.problem.gap[level.n]
+        at = getattr(level, "index", None)   # an adaptive run: its index on a finer grid
+        at = level.n if at is None else at
+        gap = None if self.problem.gap is None else self.problem.gap[at]
         fields = contact_fields(self.problem, level.contact_force, level.frame_displacement,
                                 level.on_wall, level.stuck, gap)
         fields["on_wall"] = np.asarray(level.on_wall, dtype=float)

@@ -109,6 +109,9 @@ def energy_unavailable(problem):
                 "energy balance does not hold")
     if memory is None:
         return None
+    if problem.scene.adaptive is not None:
+        return ("the discrete energy balance is that of uniform steps k = T/N; a run with "
+                "[time.adaptive] has none here")
     if problem.scene.scheme == "second-order":
         return ("the discrete energy balance is that of the paper's right rectangle rule; "
                 "the second-order scheme's trapezoidal memory has none here "

@@ -64,11 +64,11 @@ from .problem import Problem
 def build_problem(scene):
     """Discretise a scene: the stages of the module docstring, in order."""
     t0 = time.perf_counter()
-    times = scene.k * np.arange(scene.steps + 1)
+    times = time_grid(scene)
     mesh, assembly = mesh_and_dofs(scene)
     held = held_dofs(scene, mesh, assembly)
     if scene.memory is not None and scene.memory.kernel == "function":
-        check_kernel("memory.r", scene.memory.function, scene.k, scene.steps)
+        check_kernel("memory.r", scene.memory.function, times[1], times.size - 1)
     laws = contact_laws(scene)
     exact = manufactured_solution(scene, mesh, laws, times, held)
     on_contact = contact(scene, mesh, assembly, held, laws, times)
@@ -83,6 +83,15 @@ def build_problem(scene):
                    bonding=laws.bonding, probe_map=probe_map, times=times,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
                    beta_source=beta_source, held_by_contact=held_by_contact)
+
+
+def time_grid(scene):
+    """t_n = n k, n = 0..N; with [time.adaptive] the finest grid its steps
+    lie on, t_m = m k_min, m = 0..N 2^J (docs/scheme.md, "Adaptive time
+    steps"): every accepted level is one of these times."""
+    if scene.adaptive is None:
+        return scene.k * np.arange(scene.steps + 1)
+    return scene.adaptive.k_min * np.arange(scene.steps * 2 ** scene.adaptive.halvings + 1)
 
 
 # ---------------------------------------------------------------- 1. mesh and dofs
@@ -249,7 +258,14 @@ def gap_at_nodes(scene, mesh, boundary, times):
         check_outside_foundation(x, depth)
         own = np.all(nu == foundation_normal(scene.contact.foundation, x)[0], axis=0)
         g = np.where(own, np.maximum(depth, 0.0), along)
+        if scene.adaptive is not None:   # N 2^J rows of one: a read-only view
+            return np.broadcast_to(g, (times.size, g.size))
         return np.broadcast_to(g, (times.size, g.size)).copy()
+    if scene.adaptive is not None and not scene.contact.gap.depends_on_time:
+        gap = np.asarray(scene.contact.gap(*coordinates(x), t=0.0), dtype=float)
+        gap = np.broadcast_to(gap, (x.shape[1],))
+        check_gap(gap[None], x, times[:1])
+        return np.broadcast_to(gap, (times.size, gap.size))
     gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
     check_gap(gap, x, times)
     return gap

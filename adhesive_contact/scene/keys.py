@@ -125,6 +125,7 @@ MAX_CELL_ASPECT = 1e3       # longest over shortest edge of the structured cells
 MAX_NODES = 10**8           # nodes of the refined mesh
 MAX_UNIT = 16               # characters of a unit name in output.units
 MAX_MODULUS = 1e100         # |λ|, μ of a tensor (and of the sums of a memory kernel)
+MAX_HALVINGS = 20           # k_min ≥ k_max 2^-20 (time.adaptive.k_min)
 
 _DECLARATIONS = (
     Key("title", "str", "untitled", "the scene's title (it heads every plot)"),
@@ -215,6 +216,23 @@ _DECLARATIONS = (
     Key("time.scheme", "str", "paper", "the time discretisation: the paper's (right "
         "rectangle memory, first order) or the second-order one (trapezoidal memory, "
         "exponential midpoint bonding)", choices=("paper", "second-order")),
+    Key("time.adaptive", "table", None, "adaptive time steps by step doubling, k_max = T/N "
+        "(uniform steps k = T/N when absent)"),
+    # below 1e-8 the steps reach k_min everywhere; above 1 nothing is controlled
+    Key("time.adaptive.tol", "number", REQUIRED, "the local error of a pair of steps "
+        "allowed, relative to what the pair changes (u relative plus β rms)",
+        bounds=Interval(1e-8, 1.0)),
+    Key("time.adaptive.rate_floor", "number", 1e-3, "the smallest change per unit time "
+        "the tolerance is relative to (a quiet stretch counts as changing at this rate)",
+        bounds="positive"),
+    Key("time.adaptive.k_min", "number", None, "the smallest step (k_max/1024 when absent), "
+        "rounded down to k_max 2^-J", bounds="positive"),
+    Key("time.adaptive.growth", "number", 2.0, "the largest factor a step may grow by after "
+        "an accepted step", bounds=Interval(1.0, 16.0)),
+    Key("time.adaptive.shrink", "number", 0.25, "the smallest factor a step may shrink by "
+        "after a rejected one", bounds=Interval(0.01, 0.5)),
+    Key("time.adaptive.safety", "number", 0.9, "the safety factor of the step controller",
+        bounds=Interval(0.1, 1.0)),
 
     Key("solver.method", "str", "newton", "the step method", choices=tuple(STEP_METHODS)),
     Key("solver.tol", "number", 1e-10, "the step's residual, relative to its force scale",

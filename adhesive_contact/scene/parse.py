@@ -48,17 +48,17 @@ def scene_from_dict(data, base_dir=None):
         material = read_material(top.table("material"), dim)
     body, traction = read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)
     contact = read_contact(top.table("contact"), dim, contact_sides)
-    T, steps, scheme = read_time(top.table("time"))
+    T, steps, scheme, adaptive = read_time(top.table("time"))
     contact = scheme_integrator(contact, scheme, data)
     solver = read_solver(top.table("solver"))
     probes, units, plot_times = read_output(top.table("output"), dim, T)
     exact = read_exact(top.table("exact"), dim, contact, top.has("loads"))
     top.finish()
     if memory is not None and memory.kernel == "relaxation":
-        check_relaxation_step(memory, dim, T / steps)
+        check_relaxation_step(memory, dim, T / steps)   # k_max: the largest step
     scene = Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
                   traction, contact, T, steps, solver, probes, exact, displacement, units,
-                  plot_times, scheme)
+                  plot_times, scheme, adaptive)
     check_something_holds(scene, by_file)
     return scene
 

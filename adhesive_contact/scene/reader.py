@@ -46,7 +46,7 @@ class Table:
                          required=key.required)
         if key.choices is not None:
             choice(self.key(name), value, key.allowed(dim))
-        if key.bounds is not None and key.kind in ("number", "int"):
+        if key.bounds is not None and key.kind in ("number", "int") and value is not None:
             within(self.key(name), value, key.bounds, integer=key.kind == "int",
                    reason=key.reason)
         return value

@@ -29,7 +29,9 @@ def resolved(scene):
         "contact": _contact_record(scene.contact),
         "time": {"T": scene.T, "steps": scene.steps, "k": scene.k,
                  # only when not the paper's: a study recorded before the key resumes
-                 **({"scheme": scene.scheme} if scene.scheme != "paper" else {})},
+                 **({"scheme": scene.scheme} if scene.scheme != "paper" else {}),
+                 **({"adaptive": _adaptive_record(scene.adaptive)} if scene.adaptive
+                    else {})},
         "solver": _solver_record(scene.solver),
         "output": {"probes": [list(p) for p in scene.probes],
                    **({"units": dict(scene.units)} if scene.units else {}),
@@ -37,6 +39,12 @@ def resolved(scene):
                       if scene.plot_times != "auto" else {})},
         "exact": _exact_record(scene.exact),
     }
+
+
+def _adaptive_record(adaptive):
+    return {"tol": adaptive.tol, "rate_floor": adaptive.rate_floor,
+            "k_min": adaptive.k_min, "halvings": adaptive.halvings,
+            "growth": adaptive.growth, "shrink": adaptive.shrink, "safety": adaptive.safety}
 
 
 def _mesh_record(mesh):

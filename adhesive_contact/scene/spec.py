@@ -181,6 +181,20 @@ class SolverSpec:
 
 
 @dataclass(frozen=True)
+class AdaptiveSpec:
+    """``[time.adaptive]``: step doubling with steps k_max 2^-j, j = 0..halvings
+    (docs/scheme.md, "Adaptive time steps"); k_max = T/N."""
+
+    tol: float
+    k_min: float            # k_max 2^-halvings (the given k_min rounded down)
+    halvings: int           # J ≥ 1
+    rate_floor: float = default("time.adaptive.rate_floor")
+    growth: float = default("time.adaptive.growth")
+    shrink: float = default("time.adaptive.shrink")
+    safety: float = default("time.adaptive.safety")
+
+
+@dataclass(frozen=True)
 class Scene:
     """A validated scene (see the module docstring for absent tables)."""
 
@@ -203,6 +217,7 @@ class Scene:
     units: dict = field(default_factory=dict)  # quantity -> unit name ([output] units)
     plot_times: object = "auto"   # the figures' times: "auto" or a sorted tuple
     scheme: str = default("time.scheme")   # "paper" or "second-order" (docs/scheme.md)
+    adaptive: AdaptiveSpec = None   # [time.adaptive], or None: uniform steps k = T/N
 
     @property
     def held_sides(self):

@@ -3,6 +3,7 @@
 solver, the outputs and a manufactured solution."""
 
 import hashlib
+import math
 import os
 import stat
 from pathlib import Path
@@ -12,9 +13,9 @@ from ..fem.meshes.builtin import SIDES, nodes_of
 from ..linear_solvers.pardiso import available as pardiso_available
 from ..verification.manufactured import symbolic_problem
 from .errors import SceneError
-from .keys import MAX_CELL_ASPECT, MAX_NODES, MAX_UNIT, declared, keys_in
+from .keys import MAX_CELL_ASPECT, MAX_HALVINGS, MAX_NODES, MAX_UNIT, declared, keys_in
 from .reader import coordinates, expression, show, vector_of_expressions
-from .spec import ExactSpec, MeshSpec, SolverSpec
+from .spec import AdaptiveSpec, ExactSpec, MeshSpec, SolverSpec
 
 
 def read_mesh(table, dim, base_dir):
@@ -232,12 +233,37 @@ def read_loads(table, dim, dirichlet, contact_sides, named_by_file=False):
 
 
 def read_time(table):
-    """(T, steps, scheme)."""
+    """(T, steps, scheme, adaptive): ``adaptive`` the AdaptiveSpec of
+    ``[time.adaptive]``, or None."""
     T = table.read("T")
     steps = table.read("steps")
     scheme = table.read("scheme")
+    sub = table.table("adaptive")
+    adaptive = None if sub is None else read_adaptive(sub, T / steps)
     table.finish()
-    return T, steps, scheme
+    return T, steps, scheme, adaptive
+
+
+def read_adaptive(table, k_max):
+    """``[time.adaptive]`` with k_max = T/N: k_min (default k_max/1024)
+    rounded down to k_max 2^-J, 1 ≤ J ≤ MAX_HALVINGS."""
+    tol = table.read("tol")
+    rate_floor = table.read("rate_floor")
+    k_min = table.read("k_min")
+    growth, shrink, safety = table.read("growth"), table.read("shrink"), table.read("safety")
+    table.finish()
+    if k_min is None:
+        halvings = 10
+    else:
+        if not k_min <= 0.5 * k_max:
+            raise SceneError(table.key("k_min"), f"must be at most k_max/2 = {0.5 * k_max:g} "
+                             f"(k_max = T/steps), got {k_min:g}")
+        halvings = int(math.ceil(math.log2(k_max / k_min) - 1e-12))
+        if halvings > MAX_HALVINGS:
+            raise SceneError(table.key("k_min"), f"must be at least k_max 2^-{MAX_HALVINGS} = "
+                             f"{k_max * 2.0 ** -MAX_HALVINGS:g}, got {k_min:g}")
+    return AdaptiveSpec(tol, k_max * 2.0 ** -halvings, halvings, rate_floor, growth, shrink,
+                        safety)
 
 
 def read_solver(table):

@@ -15,6 +15,7 @@ same, at t_n.
 
 import time
 
+from .adaptive_loop import solve_adaptive
 from .level_checks import check_level, check_load
 from .memory import start_memory
 from .operators import StepOperators
@@ -48,6 +49,8 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     -------
     Solution : ``success``, ``status``, ``message`` say how the run ended.
     """
+    if problem.scene.adaptive is not None:   # [time.adaptive]: scheme/adaptive_loop.py
+        return solve_adaptive(problem, progress, raise_on_failure, recorder)
     t0 = time.perf_counter()
     memory = start_memory(problem)
     operators = StepOperators.build(problem, memory)

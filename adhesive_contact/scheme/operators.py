@@ -81,9 +81,12 @@ class StepOperators:
         return record
 
     @classmethod
-    def build(cls, problem, memory):
+    def build(cls, problem, memory, k=None, initial=True):
         """Factorise and condense the step matrices of ``problem`` with the
-        instantaneous tensor k R(0) of ``memory``."""
+        instantaneous tensor k R(0) of ``memory`` (k = T/N, or the step
+        ``k`` of an adaptive run); without ``initial`` the t = 0 operator is
+        not set up (an adaptive run's other step sizes: ``at(0)`` is then
+        the step matrix)."""
         t0 = time.perf_counter()
         assembly, free = problem.assembly, problem.free
         R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
@@ -160,11 +163,13 @@ class StepOperators:
 
         material = problem.scene.material
         elastic = (material.lam, material.mu)
-        dlam, dmu = memory.instantaneous(problem.scene.k)
+        dlam, dmu = memory.instantaneous(problem.scene.k if k is None else k)
         stepped = (material.lam + dlam, material.mu + dmu)
         step = step_operator(*stepped)
-        initial, shift, rho = step, None, 0.0
-        if (dlam, dmu) != (0.0, 0.0):
+        wanted, initial, shift, rho = initial, step, None, 0.0
+        if not wanted:
+            coupled(*elastic)
+        elif (dlam, dmu) != (0.0, 0.0):
             rho = contraction(elastic, (dlam, dmu), problem.dim)
             if unreduced:   # A at t = 0, preconditioned by a_n's hierarchy
                 initial = step_operator(*elastic, nearby=step.solver)

@@ -36,7 +36,12 @@ class HistoryRecorder:
         self.count = 0
 
     def record(self, level):
-        """Keep level ``level.n`` (levels arrive in order n = 0, 1, ...)."""
+        """Keep level ``level.n`` (levels arrive in order n = 0, 1, ...);
+        the arrays double when an adaptive run has more levels than N + 1."""
+        if level.n >= self.arrays["u"].shape[0]:
+            self.arrays = {name: None if a is None else
+                           np.concatenate([a, np.zeros_like(a)]) for name, a in
+                           self.arrays.items()}
         for name, array in self.arrays.items():
             if array is not None:
                 array[level.n] = getattr(level, name)

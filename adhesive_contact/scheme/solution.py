@@ -71,6 +71,9 @@ class Solution:
     # second start from z = 0 reached another solution: n -> |Δz|_∞/|z|_∞
     indefinite_steps: tuple = ()
     two_solution_steps: dict = field(default_factory=dict)
+    # [time.adaptive]: the controller's figures (tol, accepted and rejected
+    # pairs, step solves, step sizes used, ...), else None
+    adaptive: dict = None
 
     @property
     def success(self):

@@ -32,6 +32,7 @@ class State:
     memory: object       # the run's memory history (adhesive_contact.scheme.memory)
     z_before: np.ndarray = None   # the step's unknowns of level n − 1 (None before level 1)
     frame_u_before: np.ndarray = None   # frame_u of level n − 1 (None before level 1)
+    k_last: float = None   # t_n − t_{n−1} of an adaptive run (None: uniform steps k = T/N)
 
 
 @dataclass
@@ -54,6 +55,8 @@ class Level:
                                   # (with the contact laws' force along it)
     iterations: int
     residual: float
+    index: int = None             # its index in problem.times when that is not n (an
+                                  # adaptive run's levels lie on a finer grid)
 
 
 NEWTON = ("newton", "newton-plain")   # the methods that converge quadratically
@@ -246,7 +249,7 @@ def initial_state(problem, memory, unknowns=None):
                  frame_u=np.zeros(nc * problem.dim), memory=memory)
 
 
-def bonding_step(problem, state):
+def bonding_step(problem, state, k=None):
     """(4.2): β_n from β_{n−1} and u_{n−1} by the scene's integrator
     (:mod:`adhesive_contact.scheme.bonding`); explicit Euler, the paper's, is
     β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
@@ -256,15 +259,25 @@ def bonding_step(problem, state):
     The second-order scheme freezes the rate at the midpoint t_{n−½}: the
     displacement extrapolated there, u_{n−½} ≈ (3 u_{n−1} − u_{n−2})/2
     (u_0 itself for n = 1: one step's O(k²) error), the source s_β(t_{n−½});
-    its integrator (exponential midpoint) is second order in that rate."""
+    its integrator (exponential midpoint) is second order in that rate.
+
+    ``k`` is the step of an adaptive run (default k = T/N); on its
+    nonuniform grid the extrapolation is u_{n−1} + (k/(2 k_{n−1}))
+    (u_{n−1} − u_{n−2})."""
     if problem.bonding is None or state.n < 0:
         return state.beta
     boundary = problem.boundary
     frame_u, t = state.frame_u, state.t
+    uniform = k is None
+    k = problem.scene.k if uniform else k
     if problem.scene.scheme == "second-order":
-        t = state.t + 0.5 * problem.scene.k
+        t = state.t + 0.5 * k
         if state.frame_u_before is not None:
-            frame_u = 1.5 * state.frame_u - 0.5 * state.frame_u_before
+            if uniform:
+                frame_u = 1.5 * state.frame_u - 0.5 * state.frame_u_before
+            else:
+                frame_u = state.frame_u + (0.5 * k / state.k_last) * (
+                    state.frame_u - state.frame_u_before)
     r = boundary.normal_trace @ frame_u
     xi = (np.stack([trace @ frame_u for trace in boundary.tangential_trace], axis=-1)
           if boundary.tangential_trace else None)
@@ -274,7 +287,7 @@ def bonding_step(problem, state):
     if problem.beta_source is not None:   # manufactured solutions only
         source = problem.beta_source(*coordinates(boundary.points), t=t)
     rate = FacetRate(problem.bonding, r, xi, boundary.at_points, boundary.facet_mean, source)
-    return advance(problem.scene.contact.integrator, rate, state.beta, problem.scene.k)
+    return advance(problem.scene.contact.integrator, rate, state.beta, k)
 
 
 @dataclass
@@ -294,8 +307,13 @@ def step_load(problem, operators, state, n, t):
     the force of the memory history k Σ_{j<n} R(t_n − t_j) ε(u_j) (u_j the
     whole displacement, held part included), minus the force a_FD g_D(t_n)
     of the held values; and the :class:`KnownPart` of the level."""
+    return history_load(problem, operators, n, t,
+                        state.memory.history(n) if n >= 1 else None)
+
+
+def history_load(problem, operators, n, t, history):
+    """:func:`step_load` with the memory history's (a_λ, a_μ) given (None: zero)."""
     f = problem.loads(t)
-    history = state.memory.history(n) if n >= 1 else None
     if history is not None:
         f -= problem.assembly.force(*history)
     held = problem.prescribed

@@ -350,6 +350,10 @@ class ConvergenceStudy(Study):
             raise StudyError("param", f"must be one of {', '.join(PARAMS)}, got {param!r}")
         if not isinstance(levels, int) or levels < 2:
             raise StudyError("levels", f"must be an integer >= 2, got {levels!r}")
+        if given.adaptive is not None and param != "k":
+            raise StudyError("param", f"{param!r} with [time.adaptive]: a study of an adaptive "
+                             "scene refines time.adaptive.tol (--param k); for h use the scene "
+                             "without [time.adaptive]")
         self.base = (refine, steps)
         self.scene = with_discretisation(given, refine, steps)
         memory = self.scene.memory

@@ -45,8 +45,14 @@ def with_discretisation(scene, refine=None, steps=None):
 
 
 def level_scene(scene, param, level):
-    """The scene of one level of a study."""
+    """The scene of one level of a study. With [time.adaptive] a level in k
+    halves ``time.adaptive.tol`` instead of the step (k_max stays T/N)."""
     refine = scene.mesh.refine + (level if param in ("h", "hk") else 0)
+    if scene.adaptive is not None:
+        if param in ("k", "hk"):
+            scene = replace(scene, adaptive=replace(scene.adaptive,
+                                                    tol=scene.adaptive.tol * 2.0 ** -level))
+        return with_discretisation(scene, refine)
     steps = scene.steps * (2 ** level if param in ("k", "hk") else 1)
     return with_discretisation(scene, refine, steps)
 
@@ -67,6 +73,10 @@ def reference_scene(scene, param, levels, ref_h=None, ref_k=None):
     ref_h = dh if ref_h is None else ref_h
     ref_k = dk if ref_k is None else ref_k
     finest = level_scene(scene, param, levels - 1)
+    if finest.adaptive is not None:   # uniform, of step k_min 2^(4 − ref_k) (k_min by default)
+        halvings = max(finest.adaptive.halvings + ref_k - 4, 0) if param != "h" else 0
+        return with_discretisation(replace(finest, adaptive=None), finest.mesh.refine + ref_h,
+                                   finest.steps * 2 ** halvings)
     return with_discretisation(finest, finest.mesh.refine + ref_h, finest.steps * 2 ** ref_k)
 
 
@@ -104,28 +114,54 @@ def _errors_against_reference(problem, solution, reference):
     fine = meshes[-1]
     P = prolongation(meshes)
     B = strain_map(stiffness_basis(fine))
-    ratio = reference.scene.steps // scene.steps
-    if ratio * scene.steps != reference.scene.steps:
-        raise ValueError("the reference steps are not a multiple of the level's steps")
+    if scene.adaptive is None:
+        ratio = reference.scene.steps // scene.steps
+        if ratio * scene.steps != reference.scene.steps:
+            raise ValueError("the reference steps are not a multiple of the level's steps")
+        at = [((n * ratio, 1.0),) for n in range(scene.steps + 1)]
+    else:   # an adaptive level's t_n: the reference interpolated linearly in time
+        at = reference_at(solution.t, reference.scene.k, reference.scene.steps)
     parents = None
     if problem.boundary is not None and problem.boundary.facets.size:
         parents = facet_parents(meshes, problem.boundary.facets, reference.facets)
     lengths = _facet_lengths(fine, reference.facets)
     err_u, err_b, norm_u, norm_b = [], [], [], []
-    for n in range(scene.steps + 1):
+    for n, weights in enumerate(at):
+        ref_u = _combine(reference.u, weights)
         uf = P @ solution.u[n]                                   # (npoints_f, d)
-        du = (uf - reference.u[n * ratio]).ravel()
+        du = (uf - ref_u).ravel()
         err_u.append(strain_error_fine(fine, B, du))
-        norm_u.append(strain_error_fine(fine, B, reference.u[n * ratio].ravel()))
+        norm_u.append(strain_error_fine(fine, B, ref_u.ravel()))
         if parents is None:
             err_b.append(0.0)
             norm_b.append(0.0)
         else:
-            ref_beta = reference.beta[n * ratio]
+            ref_beta = _combine(reference.beta, weights)
             db = solution.beta[n][parents] - ref_beta
             err_b.append(float(np.sqrt(np.sum(lengths * db * db))))
             norm_b.append(float(np.sqrt(np.sum(lengths * ref_beta * ref_beta))))
     return np.array(err_u), np.array(err_b), np.array(norm_u), np.array(norm_b)
+
+
+def reference_at(t, k, steps):
+    """Per time of ``t`` the reference levels and weights that interpolate a
+    uniform reference (step ``k``, ``steps`` steps) linearly there:
+    ((m, 1),) where t is a reference level, else ((m, 1 − w), (m + 1, w))."""
+    out = []
+    for s in np.asarray(t, dtype=float) / k:
+        m = int(np.floor(s + 1e-9))
+        w = s - m
+        out.append(((min(m, steps), 1.0),) if abs(w) <= 1e-9 or m >= steps
+                   else ((m, 1.0 - w), (m + 1, w)))
+    return out
+
+
+def _combine(levels, weights):
+    """Σ w_i levels[m_i] (the level itself for one weight 1)."""
+    if len(weights) == 1:
+        return levels[weights[0][0]]
+    (m0, w0), (m1, w1) = weights
+    return w0 * levels[m0] + w1 * levels[m1]
 
 
 def _facet_lengths(mesh, facets):
@@ -193,9 +229,11 @@ def run_level(scene, param, level, reference=None, progress=None, measure=None):
     else:
         err_u, err_b, norm_u, norm_b = _errors_against_reference(problem, solution, reference)
     E = err_u + err_b
+    # adaptive: the accepted steps M and their mean T/M
+    steps = lscene.steps if lscene.adaptive is None else solution.steps
     record = {
-        "level": level, "h": mesh_size(problem.mesh), "k": lscene.k,
-        "dofs": int(problem.ndofs), "steps": lscene.steps, "refine": lscene.mesh.refine,
+        "level": level, "h": mesh_size(problem.mesh), "k": lscene.T / steps,
+        "dofs": int(problem.ndofs), "steps": steps, "refine": lscene.mesh.refine,
         "err_u": float(err_u.max()), "err_beta": float(err_b.max()), "E": float(E.max()),
         "rel_u": relative(err_u, norm_u), "rel_beta": relative(err_b, norm_b),
         "rel_E": relative(E, norm_u + norm_b),
@@ -203,6 +241,9 @@ def run_level(scene, param, level, reference=None, progress=None, measure=None):
         "stepping_seconds": solution.timings["stepping"],
         "newton_iterations": int(solution.iterations.sum()),
     }
+    if solution.adaptive is not None:
+        record["adaptive"] = {key: solution.adaptive[key] for key in (
+            "tol", "accepted_steps", "rejected_pairs", "forced_pairs", "step_solves")}
     if measure is not None:
         record["quantities"] = measure(solution)
     return record

@@ -1,0 +1,166 @@
+"""The step controller of adaptive time steps (``[time.adaptive]``,
+docs/scheme.md, "Adaptive time steps").
+
+Steps are quantised: h = k_max 2^{−j}, j = j_0..J, k_max = T/N, k_min =
+k_max 2^{−J}, so that every level lies on the grid t_m = m k_min and the
+step matrices A + h R(0) (and A + 2h R(0) of the doubled step) are
+factorised once per j that the run uses (:mod:`.adaptive_loop`).
+Positions are counted in units of k_min (integers: no drift of t).
+
+The local error of a pair of half steps h is estimated by step doubling,
+from the one step 2h over the same interval (Richardson, scheme of order p),
+
+    err = ‖y_{2×h} − y_{2h}‖ / (2^p − 1),   ‖y‖ = ‖u‖_2 / U + ‖β‖_{rms}
+
+with U the largest ‖u_n‖_2 so far (a relative displacement) and the rms of
+β weighted by the facet measures. The tolerance is relative to what the
+pair changes, Δ = ‖y_{t+2h} − y_t‖ in the same norm, floored at
+``rate_floor`` 2h/T (a quiet stretch counts as changing at that rate): the
+pair is accepted when q = err / (tol max(Δ, rate_floor 2h/T)) ≤ 1, or when
+h = k_min already. This controls the local time lag err/|y'| of the
+pair rather than its error per unit time: an error made early in a
+debonding is carried to the end as a lag of the front, and the error of a
+lag grows with the front's speed (studies/convergence/adaptive). The next
+half step (after a rejection, the retried one) is
+
+    h_new = h · min(growth, max(shrink, safety · q^{−1/p}))
+
+rounded down to the quantised set, capped at the explicit Euler bound of
+the bonding law (2h ≤ k_E, the doubled step included) and at what is left
+of [0, T]. With err ∝ h^{p+1} and Δ ∝ h, q ∝ h^p: the exponent 1/p makes
+q ≈ safety^p.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class StepSizes:
+    """The quantised half steps h_j = k_max 2^{−j}, j = ``first``..``halvings``,
+    and the grid of units k_min = k_max 2^{−halvings} that [0, T] spans
+    (``units`` of them)."""
+
+    k_max: float
+    halvings: int
+    units: int
+    first: int = 0      # the largest allowed half step is k_max 2^{-first}
+
+    @classmethod
+    def of(cls, scene, stable_step=math.inf):
+        """The step sizes of an adaptive ``scene`` with the explicit Euler
+        bound ``stable_step`` on every step (the doubled one included)."""
+        adaptive = scene.adaptive
+        k_max = scene.k
+        first = 0
+        while first < adaptive.halvings and 2.0 * k_max * 2.0 ** -first > stable_step:
+            first += 1
+        return cls(k_max, adaptive.halvings, scene.steps * 2 ** adaptive.halvings, first)
+
+    def size(self, j):
+        """h_j = k_max 2^{−j}: exact, a power of two times k_max."""
+        return self.k_max * 2.0 ** -j
+
+    def span(self, j):
+        """h_j in units of k_min."""
+        return 2 ** (self.halvings - j)
+
+    def index(self, target, at):
+        """The j of the largest quantised half step ≤ ``target`` whose doubled
+        step 2h_j fits in what is left after unit ``at``, within
+        [first, halvings]."""
+        if target >= self.k_max:
+            j = self.first
+        else:
+            j = max(self.first, int(math.ceil(math.log2(self.k_max / target) - 1e-12)))
+        j = min(j, self.halvings)
+        while j < self.halvings and 2 * self.span(j) > self.units - at:
+            j += 1
+        return j
+
+
+@dataclass
+class Controller:
+    """Accepts or rejects a pair of half steps and picks the next half step.
+
+    ``tol``, ``rate_floor``, ``growth``, ``shrink``, ``safety`` of [time.adaptive], ``order``
+    p of the scheme (1 the paper's, 2 the second-order one), ``T`` the final
+    time. Counts ``accepted``, ``rejected`` and ``forced`` pairs (accepted
+    at k_min with q > 1)."""
+
+    sizes: StepSizes
+    tol: float
+    T: float
+    order: int = 1
+    rate_floor: float = 1e-3
+    growth: float = 2.0
+    shrink: float = 0.25
+    safety: float = 0.9
+    accepted: int = 0
+    rejected: int = 0
+    forced: int = 0
+
+    @classmethod
+    def of(cls, scene, stable_step=math.inf):
+        a = scene.adaptive
+        return cls(StepSizes.of(scene, stable_step), a.tol, scene.T,
+                   2 if scene.scheme == "second-order" else 1, a.rate_floor, a.growth,
+                   a.shrink, a.safety)
+
+    def ratio(self, err, j, change=0.0):
+        """q = err / (tol max(Δ, rate_floor 2h_j/T)), Δ = ``change`` of the pair."""
+        return err / (self.tol * max(change, self.rate_floor * 2.0 * self.sizes.size(j)
+                                     / self.T))
+
+    def factor(self, q):
+        """min(growth, max(shrink, safety q^{−1/p}))."""
+        if q <= 0.0:
+            return self.growth
+        return min(self.growth, max(self.shrink, self.safety * q ** (-1.0 / self.order)))
+
+    def judge(self, err, j, at, change=0.0):
+        """(accept, next j) for a pair of half steps h_j starting at unit
+        ``at`` with estimated error ``err`` and change Δ = ``change``; the
+        next j is that of the pair after it (accepted: from ``at + 2
+        span(j)``) or of the retry."""
+        q = self.ratio(err, j, change)
+        finite = math.isfinite(q)
+        accept = (finite and q <= 1.0) or j == self.sizes.halvings
+        target = self.sizes.size(j) * (self.factor(q) if finite else self.shrink)
+        if accept:
+            self.accepted += 1
+            self.forced += not (finite and q <= 1.0)
+            return True, self.sizes.index(target, at + 2 * self.sizes.span(j))
+        self.rejected += 1
+        return False, max(j + 1, self.sizes.index(target, at))
+
+    def failed(self, j, at):
+        """The retry after a trial whose step solve failed: (can retry, next j)."""
+        if j >= self.sizes.halvings:
+            return False, j
+        self.rejected += 1
+        return True, max(j + 1, self.sizes.index(self.sizes.size(j) * self.shrink, at))
+
+
+@dataclass
+class PairNorm:
+    """‖(u, β)‖ = ‖u‖_2 / U + (Σ_f |f| β_f² / |Γ_C|)^½ of the estimate,
+    U the largest ‖u_n‖_2 of the run so far (:meth:`scale` keeps it)."""
+
+    measure: np.ndarray   # (nf,) facet measures, or empty
+    largest: float = 0.0
+
+    def scale(self, u):
+        self.largest = max(self.largest, float(np.linalg.norm(u)))
+
+    def __call__(self, du, dbeta, order=1):
+        # order=1: the norm itself (the pair's change Δ)
+        """The Richardson estimate of the pair's error from the differences
+        of the doubled step to the pair: (‖du‖/U + rms dβ) / (2^p − 1)."""
+        eu = float(np.linalg.norm(du)) / self.largest if self.largest > 0 else 0.0
+        eb = 0.0
+        if self.measure.size:
+            eb = math.sqrt(float(self.measure @ (dbeta * dbeta)) / float(self.measure.sum()))
+        return (eu + eb) / (2 ** order - 1)
