@@ -154,6 +154,21 @@ def test_explicit_euler_beyond_its_bound_warns_once_with_the_cost_of_the_others(
                          + BEYOND_TIME_SCALE + " " + ANCHOR)
 
 
+def test_adaptive_steps_are_not_held_to_the_guides_of_a_uniform_step():
+    # k_max = T/N beyond both guides: the controller caps explicit Euler at its
+    # bound and chooses the other steps by its tolerance
+    for integrator in ("explicit", "implicit"):
+        data = tomllib.loads(PEEL.read_text())
+        data["time"]["steps"] = 5
+        data["contact"]["bonding"]["integrator"] = integrator
+        uniform = build_problem(scene_from_dict(data, base_dir=PEEL.parent)).warnings()
+        assert any(STOPS in w or TIME_SCALE in w for w in uniform)
+        assert accuracy_lines(uniform)
+        data["time"]["adaptive"] = {"tol": 0.01}
+        adaptive = build_problem(scene_from_dict(data, base_dir=PEEL.parent)).warnings()
+        assert not any(STOPS in w or TIME_SCALE in w or MEMORY in w for w in adaptive)
+
+
 def test_the_cost_statement_holds_the_measured_figures():
     # studies/stability/time_accuracy/peel.csv, written by time_accuracy.py
     rows = (ROOT / "studies/stability/time_accuracy/peel.csv").read_text().splitlines()

@@ -174,10 +174,11 @@ def held_by_contact_warning(problem):
 
 
 def explicit_bound_warning(problem):
-    """A line when the step exceeds the explicit Euler bound of the bonding law."""
+    """A line when the step exceeds the explicit Euler bound of the bonding
+    law (never with ``[time.adaptive]``, whose steps stay below the bound)."""
     scene = problem.scene
     if (problem.bonding is None or scene.contact.integrator != "explicit"
-            or scene.k <= problem.bonding.stable_step()):
+            or scene.adaptive is not None or scene.k <= problem.bonding.stable_step()):
         return None
     return (f"the time step k = {scene.k:.4g} exceeds the explicit Euler bound "
             f"1/((gamma_nu + gamma_tau) L^2) = {problem.bonding.stable_step():.4g} of "
@@ -191,10 +192,12 @@ def time_scale_warning(problem):
     """A line when an integrator other than explicit Euler (which has
     :func:`explicit_bound_warning`) runs at a step beyond the bonding law's
     time scale 1/((γ_ν + γ_τ) L²): stable, but the debonding front lags
-    (:mod:`.accuracy`)."""
+    (:mod:`.accuracy`). Not with ``[time.adaptive]``: its error control
+    chooses the steps."""
     scale = bonding_time_scale(problem)
     scene = problem.scene
-    if scale is None or scene.contact.integrator == "explicit" or scene.k <= scale:
+    if (scale is None or scene.contact.integrator == "explicit" or scene.adaptive is not None
+            or scene.k <= scale):
         return None
     return (f"the time step k = {scene.k:.4g} is {scene.k / scale:.3g} times the explicit "
             f"Euler bound 1/((gamma_nu + gamma_tau) L^2) = {scale:.4g} of the bonding law: "
@@ -210,8 +213,11 @@ MEMORY_RULES = {"paper": "right rectangle rule", "second-order": "trapezoidal ru
 def memory_step_warning(problem):
     """A line when the memory's quadrature at the scene's k puts the stress
     of a strain held from t = 0 off by more than MEMORY_GUIDE at T
-    (:func:`.accuracy.memory_error`)."""
+    (:func:`.accuracy.memory_error`). Not with ``[time.adaptive]``: its
+    error control chooses the steps."""
     scene = problem.scene
+    if scene.adaptive is not None:
+        return None
     error = memory_error(scene)
     if error is None or error <= MEMORY_GUIDE:
         return None
