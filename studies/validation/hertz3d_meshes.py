@@ -11,7 +11,9 @@ centres and its centre, a split with the cube's symmetries, so that the
 mesh is its own mirror image in the symmetry planes (:func:`cube_split`). Sides: ``top`` (z = 0), ``xsym`` (x = 0),
 ``ysym`` (y = 0), ``bottom`` (z = −1), ``xside`` (x = 1), ``yside``
 (y = 1). L = 0, 1 is h_c = 0.01, 0.0075 (about 220 000 and 280 000 dofs);
-``sphere_test`` (h_c = 0.02) is the test's.
+``sphere_test`` (h_c = 0.02) is the test's; ``sphere_coarse`` (h_c = 0.05,
+3 000 nodes) is committed, the mesh hertz3d_sphere.toml names, so that the
+scene runs as it is. Binary gmsh 2.2 files.
 """
 
 from pathlib import Path
@@ -22,7 +24,7 @@ from skfem import MeshTet
 
 HERE = Path(__file__).parent / "meshes"
 CORE, GROWTH, WIDTH = 0.11, 1.3, 1.0
-LEVELS = {"test": 0.02, 0: 0.01, 1: 0.0075}
+LEVELS = {"coarse": 0.05, "test": 0.02, 0: 0.01, 1: 0.0075}
 
 
 def graded(h_c, core=CORE, length=WIDTH, growth=GROWTH):
@@ -107,17 +109,17 @@ def block(h_c):
 
 
 def write(path, mesh, sides):
-    """A gmsh 2.2 file with the named sides."""
+    """A binary gmsh 2.2 file with the named sides."""
     blocks = [("triangle", f.T) for f in sides.values()] + [("tetra", mesh.t.T)]
     tags = [np.full(len(b[1]), i + 1) for i, b in enumerate(blocks)]
     field = {name: np.array([i + 1, 2]) for i, name in enumerate(sides)}
     field["body"] = np.array([len(sides) + 1, 3])
     meshio.write(path, meshio.Mesh(mesh.p.T, blocks,
                                    cell_data={"gmsh:physical": tags, "gmsh:geometrical": tags},
-                                   field_data=field), file_format="gmsh22", binary=False)
+                                   field_data=field), file_format="gmsh22", binary=True)
 
 
-def main(levels=(0, 1), folder=HERE):
+def main(levels=("coarse", 0, 1), folder=HERE):
     folder.mkdir(exist_ok=True)
     for level in levels:
         mesh, sides = block(LEVELS[level])
