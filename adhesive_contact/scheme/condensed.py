@@ -211,11 +211,12 @@ class DenseSchur(RememberedProduct):
             self._chord = (free.copy(), solve)
         return solve(rhs), True
 
-    def chord_solve(self, rhs, free):
+    def chord_solve(self, rhs, free, accuracy=None):
         """Solve the matrix (S + H_φ)_FF of the last :meth:`newton_solve`
         again, its factorisation reused, for a new right-hand side (the
-        chord step of :mod:`adhesive_contact.step_methods.newton`): d, or
-        None when ``free`` is not its F or that matrix was indefinite."""
+        chord step of :mod:`adhesive_contact.step_methods.newton`; to
+        round-off, ``accuracy`` is not needed): d, or None when ``free`` is
+        not its F or that matrix was indefinite."""
         if self._chord is None or not np.array_equal(self._chord[0], free):
             return None
         return self._chord[1](rhs)

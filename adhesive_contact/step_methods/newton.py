@@ -146,9 +146,12 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         if status is not None:
             break
 
+        forcing = (min(eisenstat_walker(residual, last_residual), residual / scale)
+                   if globalised else 1e-12)
         if chord is not None:
             # a chord step on the last Newton matrix, counted with its iteration
-            accepted, chord = chord_step(S, upper, z, E, st, kink, chord, total,
+            accepted, chord = chord_step(S, upper, z, E, st, kink, chord,
+                                         (forcing, 0.5 * tol * scale), total,
                                          noise(z, st.Sz), sigma), None
             if accepted is not None:
                 before_chord = (z, E, st)
@@ -157,7 +160,6 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             if it == max_iter:
                 status = MAX_ITERATIONS
                 break
-        forcing = eisenstat_walker(residual, last_residual) if globalised else 1e-12
         if semismooth:
             # the semismooth Newton step, its sets free to change; when its
             # line search fails, the held-direction iteration below
@@ -401,7 +403,7 @@ def semismooth_step(S, energy, upper, z, E, st, kink, accuracy, total, slack, si
     return (trial, E_trial), solved, chord
 
 
-def chord_step(S, upper, z, E, st, kink, chord, total, slack, sigma):
+def chord_step(S, upper, z, E, st, kink, chord, accuracy, total, slack, sigma):
     """The chord step after a full semismooth step: the Newton equations of
     the projection form at the new z solved with the matrix of the last
     step, its factorisation reused (``S.chord_solve``), when z has the sets
@@ -419,7 +421,7 @@ def chord_step(S, upper, z, E, st, kink, chord, total, slack, sigma):
     if not (np.array_equal(form.fixed, last.fixed) and np.array_equal(form.wall, last.wall)):
         return None
     d = np.zeros(z.size)
-    step = solve(form.rhs[free], free)
+    step = solve(form.rhs[free], free, accuracy=accuracy)
     if step is None:
         return None
     d[free] = step

@@ -87,13 +87,16 @@ def instrument(profile):
 
     for cls in (condensed.DenseSchur, condensed.ImplicitSchur, full_system.FullSystemMatrix):
         profile.wrap(cls, "newton_solve", "newton_solve")
+        if hasattr(cls, "chord_solve"):   # the chord steps' solves with the same matrix
+            profile.wrap(cls, "chord_solve", "newton_solve")
     profile.wrap(AMGSolver, "updated", "updates")
     profile.wrap(ContactEnergy, "hessian", "hessian")
     profile.wrap(condensed.RememberedProduct, "__matmul__", "products")
     profile.wrap(condensed.ImplicitSchur, "__matmul__", "products")
     profile.wrap(newton, "backtrack", "line_search")
-    if hasattr(newton, "semismooth_step"):   # its sets and its line search
-        profile.wrap(newton, "semismooth_step", "line_search")
+    for name in ("semismooth_step", "chord_step"):   # their sets and line searches
+        if hasattr(newton, name):
+            profile.wrap(newton, name, "line_search")
     profile.wrap(newton, "stationarity", "residual")
     for name in ("update_factor", "bordered_solve"):   # factor updates, where the code has them
         for cls in (condensed.DenseSchur,):
