@@ -130,7 +130,11 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     inner_failures = 0
     last_residual = None
     it = 0   # Newton iterations (a chord step is part of the one before it)
-    chord = before_chord = None
+    # a chord step on the last Newton system of S first (that of the last
+    # solve with S: the previous level's, or the previous proximal step's
+    # at t = 0), where S keeps one
+    chord = getattr(S, "chord_start", None) if semismooth else None
+    before_chord = None
     while True:
         st = stationarity(S, c, energy, upper, z, kink)
         if before_chord is not None:
@@ -167,6 +171,8 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
                                                       (forcing, 0.5 * tol * scale),
                                                       total, noise(z, st.Sz), sigma)
             inner_failures += not solved
+            if chord is not None and hasattr(S, "chord_start"):
+                S.chord_start = chord   # for the next solve with S too
             if accepted is not None:
                 z, E = accepted
                 last_residual = residual
@@ -399,7 +405,8 @@ def semismooth_step(S, energy, upper, z, E, st, kink, accuracy, total, slack, si
     if accepted is None:
         return None, solved, None
     trial, E_trial, alpha = accepted
-    chord = (gamma, form, free, floor) if alpha == 1.0 and free.any() else None
+    chord = ((gamma, form, free, floor, getattr(S, "kept", None))
+             if alpha == 1.0 and free.any() else None)
     return (trial, E_trial), solved, chord
 
 
@@ -414,14 +421,14 @@ def chord_step(S, upper, z, E, st, kink, chord, accuracy, total, slack, sigma):
     only, by the Armijo test of the module doc: (z, E) or None (no chord
     solve for this matrix, other sets, or no decrease)."""
     solve = getattr(S, "chord_solve", None)
-    gamma, last, free, floor = chord
+    gamma, last, free, floor, system = chord
     if solve is None:
         return None
     form = projection_form(z, st, upper, gamma, kink, floor)
     if not (np.array_equal(form.fixed, last.fixed) and np.array_equal(form.wall, last.wall)):
         return None
     d = np.zeros(z.size)
-    step = solve(form.rhs[free], free, accuracy=accuracy)
+    step = solve(form.rhs[free], free, accuracy=accuracy, system=system)
     if step is None:
         return None
     d[free] = step
