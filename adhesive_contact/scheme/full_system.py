@@ -95,8 +95,6 @@ class FullSystemMatrix(RememberedProduct):
         self.iterations = 0         # CG iterations of all Newton systems so far
         self.indefinite = False     # CG of the last Newton system met pᵀ K p ≤ 0
         self.indefinite_solves = 0  # and how many did so far
-        self.kept = None            # (F, K − a_n, preconditioner) of the last Newton system
-        self.chord_start = None     # the step method's sets of that system (its chord step)
 
     @property
     def matrix(self):
@@ -120,7 +118,6 @@ class FullSystemMatrix(RememberedProduct):
         the 3D full model of studies/bench/ladder.py at 2.8e4 dofs; slip
         weakening and a breaking glue make a_n + H_φ far from a_n near Γ_C)."""
         rtol, atol = accuracy if accuracy is not None else (self.solver.tol, 0.0)
-        self.release()
         shift = self._shift(sp.csr_matrix(H_phi), ~free)
         _, precondition = self.solver.updated(shift)
         full = np.zeros(free.size)
@@ -138,33 +135,7 @@ class FullSystemMatrix(RememberedProduct):
                                                 full, rtol, atol, self.maxiter,
                                                 on_negative_curvature=negative)
         self.iterations += iterations
-        if not self.indefinite:
-            self.kept = (free.copy(), shift, precondition)
         return d[free], converged
-
-    def chord_solve(self, rhs, free, accuracy=None, system=None):
-        """Solve K of the last :meth:`newton_solve` again for a new
-        right-hand side, with its preconditioner (the hierarchy updated
-        for it, valid until the next update): the chord step of
-        :mod:`adhesive_contact.step_methods.newton`, to ``accuracy`` as
-        there. d, or None when ``system`` (:attr:`kept` when the caller
-        solved it) is no longer the kept one, ``free`` is not its F, K was
-        indefinite or CG does not reach the accuracy."""
-        if self.kept is None or system is not self.kept or not np.array_equal(self.kept[0], free):
-            return None
-        _, shift, precondition = self.kept
-        rtol, atol = accuracy if accuracy is not None else (self.solver.tol, 0.0)
-        full = np.zeros(free.size)
-        full[free] = rhs
-        d, converged, iterations = truncated_cg(lambda v: self.A @ v + shift @ v,
-                                                lambda r: precondition @ r,
-                                                full, rtol, atol, self.maxiter)
-        self.iterations += iterations
-        return d[free] if converged else None
-
-    def release(self):
-        """Let the preconditioner kept for :meth:`chord_solve` go."""
-        self.kept = self.chord_start = None
 
     def _shift(self, H, held):
         """K − a_n for K of :meth:`newton_solve`: Π H Π − (the entries of a_n
