@@ -162,6 +162,8 @@ class DenseSchur(RememberedProduct):
         self.matrix = S
         self.shape = S.shape
         self._single = None   # S in single precision, made on first use
+        self.kept = None         # (F, solve) of the last Newton system, for chord_solve
+        self.chord_start = None  # the step method's sets of that system (its chord step)
 
     def diagonal(self):
         return np.diag(self.matrix)
@@ -174,6 +176,7 @@ class DenseSchur(RememberedProduct):
         Only the entries of H_φ are added to the copy of S_FF; from
         MIXED_FROM free coordinates on, that copy is taken in single
         precision and the products of the refinement use S itself."""
+        self.release()   # the last factor goes before the next is made
         idx = np.flatnonzero(free)
         everything = idx.size == free.size
         block = restricted(H_phi, free)
@@ -200,11 +203,30 @@ class DenseSchur(RememberedProduct):
             solve = mixed_precision_solver(H32, apply, largest, exact)
             if solve is not None:
                 self.indefinite = False
+                self.kept = (free.copy(), solve)
                 return solve(rhs), True
         solve = dense_solver(exact(), mixed_from=np.inf)
         self.indefinite = solve.indefinite
         self.indefinite_solves += solve.indefinite
+        if not solve.indefinite:
+            self.kept = (free.copy(), solve)
         return solve(rhs), True
+
+    def chord_solve(self, rhs, free, accuracy=None, system=None):
+        """Solve the matrix (S + H_φ)_FF of the last :meth:`newton_solve`
+        again, its factorisation reused, for a new right-hand side (the
+        chord step of :mod:`adhesive_contact.step_methods.newton`; to
+        round-off, ``accuracy`` is not needed): d, or None when
+        ``system`` (:attr:`kept` when the caller solved it) is no longer
+        the kept one, ``free`` is not its F, or that matrix was
+        indefinite."""
+        if self.kept is None or system is not self.kept or not np.array_equal(self.kept[0], free):
+            return None
+        return self.kept[1](rhs)
+
+    def release(self):
+        """Let the factor kept for :meth:`chord_solve` go."""
+        self.kept = self.chord_start = None
 
 
 class ImplicitSchur:

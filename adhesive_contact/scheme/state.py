@@ -115,9 +115,10 @@ class ContactStep:
         if self.kink is not None and np.any(self.kink.tangential < 0):
             self.kink.offset = values.reshape(boundary.held.shape)[self.kink_nodes, 1:]
 
-    def minimise(self, S, c, beta, n, z0, tighter=1.0, before=None):
+    def minimise(self, S, c, beta, n, z0, tighter=1.0, before=None, iterations=None):
         """The step solve of (4.1) on the contact unknowns with β_n, by
-        ``solver.method``; a Newton method's tolerance times ``tighter``.
+        ``solver.method``; a Newton method's tolerance times ``tighter``
+        and, with ``iterations``, its iterations at most that many.
         ``z0`` is the last level's solution; with ``before``, the one of
         the level before it, the "newton" method starts from the
         :meth:`predictor` where that lowers the step energy."""
@@ -129,6 +130,8 @@ class ContactStep:
         options = self.options(S)
         if solver.method in NEWTON:
             options = replace(options, tol=max(options.tol * tighter, 1e-14))
+            if iterations is not None:
+                options = replace(options, max_iter=min(options.max_iter, iterations))
         upper = np.full(self.size, np.inf)
         upper[self.unknowns] = problem.upper_bound(n)
         start = time.perf_counter()
@@ -387,16 +390,19 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0, z_before=N
     return level, u, frame_u, z, result
 
 
-def free_solve(step, contact, n, b, beta, z0, tighter=1.0, before=None):
+def free_solve(step, contact, n, b, beta, z0, tighter=1.0, before=None, iterations=None):
     """The free dofs of (4.1) with the condensed step matrix ``step`` and
     the load b: the contact problem on z, then the interior by back
     substitution. Returns ``(u_free, z, c, result)``, u_free None when the
-    contact solve failed; ``result`` None without Γ_C."""
+    contact solve failed; ``result`` None without Γ_C. With ``iterations``
+    the contact solve takes at most that many Newton iterations, and an
+    iterate it leaves unconverged (MAX_ITERATIONS) is expanded as well."""
     c = step.reduce(b)
     result, z = None, z0
     if contact is not None:
-        result = contact.minimise(step.S, c, beta, n, z0, tighter, before)
-        if not result.success:
+        result = contact.minimise(step.S, c, beta, n, z0, tighter, before, iterations)
+        partial = iterations is not None and result.status == MAX_ITERATIONS
+        if not (result.success or partial):
             return None, z0, c, result
         z = result.z
     return step.expand(z, b), z, c, result
@@ -406,24 +412,40 @@ def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13
     """The t = 0 problem min ½ uᵀ A u − bᵀ u + Φ(u_C) on the free dofs with the
     factorisation of a_n = A + D only (:mod:`adhesive_contact.scheme.operators`):
     u⁽ⁱ⁺¹⁾ solves the step with the load b + D u⁽ⁱ⁾, from u⁽⁰⁾ = 0, until
-    ‖u⁽ⁱ⁺¹⁾ − u⁽ⁱ⁾‖ ≤ rtol ‖u⁽ⁱ⁺¹⁾‖ (the error is then about
-    ρ/(1 − ρ) of that, ρ ≤ ``contraction`` ≤ 0.3). The returned result
-    counts the Newton iterations of all of them; its load c is that of the
-    last, so that S z − c is the contact force of the t = 0 problem
-    (a_n u − D u = A u). Same returns as :func:`free_solve`."""
+    ‖u⁽ⁱ⁺¹⁾ − u⁽ⁱ⁾‖ ≤ rtol ‖u⁽ⁱ⁺¹⁾‖ with the step converged (the error is
+    then about ρ/(1 − ρ) of that, ρ ≤ ``contraction`` ≤ 0.3).
+
+    Each step solve takes one Newton iteration from u⁽ⁱ⁾ (a proximal
+    Newton method): the step energy is the t = 0 energy plus ½‖u − u⁽ⁱ⁾‖²_D,
+    so an iteration that lowers it lowers the t = 0 energy, and the contact
+    sets settle while the linear part contracts, instead of one after the
+    other. A step it leaves unconverged is not one of the ``limit`` step
+    solves; more than ``solver.max_iter`` of them are the t = 0 step's
+    failure (MAX_ITERATIONS). The returned result counts the Newton
+    iterations of all of them; its load c is that of the last, so that
+    S z − c is the contact force of the t = 0 problem (a_n u − D u = A u).
+    Same returns as :func:`free_solve`."""
     u = np.zeros(b.size)
     # ρ^i below rtol, with a margin for the contact terms' nonlinearity
     limit = 10 + int(np.log(rtol) / np.log(max(contraction, 1e-3)))
-    total = 0
-    for _ in range(limit):
+    budget = 0 if contact is None else int(contact.problem.scene.solver.max_iter)
+    total = settled = unsettled = 0
+    while settled < limit:
         u_next, z0, c, result = free_solve(step, contact, n, b + shift @ u, beta, z0,
-                                           tighter=1e-2)
+                                           tighter=1e-2, iterations=1)
+        converged = result is None or result.success
         if result is not None:
             total += result.nit
             result.nit = total
         if u_next is None:
             return None, z0, c, result
-        done = np.linalg.norm(u_next - u) <= rtol * np.linalg.norm(u_next)
+        settled += converged
+        unsettled += not converged
+        if unsettled > budget:
+            return None, z0, c, replace(result, message=(
+                f"no convergence in {budget} iterations (the Newton steps of the t = 0 "
+                f"iteration on the step matrix)"))
+        done = converged and np.linalg.norm(u_next - u) <= rtol * np.linalg.norm(u_next)
         u = u_next
         if done:
             return u, z0, c, result

@@ -15,7 +15,14 @@ Each iteration first tries the semismooth Newton step of
 conditions (the min function for the wall, the shrink operator for the
 kink), whose sets follow the iterate coordinate by coordinate and whose
 slip directions may turn inside a step; its trial points must pass the
-same Armijo test. When none does, the iteration is the held-direction
+same Armijo test. After a full semismooth step whose sets the new iterate
+keeps, :func:`chord_step` solves the Newton equations at the new iterate
+with the same matrix, its factorisation reused (a simplified Newton
+step, part of the same iteration: ``nit`` counts the Newton matrices);
+it is kept where it divides the residual by 1/CHORD_GAIN. A solve starts
+with the same step on the last Newton system its operator S keeps
+(``S.chord_start``, from the previous solve with S). When no
+semismooth trial passes, the iteration is the held-direction
 one below (and "newton-plain" uses only that one): a projected semismooth
 Newton iteration with an Armijo line
 search on E, combining Bertsekas' two-metric projection for the wall with
@@ -49,6 +56,8 @@ line search and no gradient fallback, what many codes do; it stops as
 DIVERGED when the energy or the iterate stops being finite or the iterate
 grows past 1e8 times the size of the first one.
 """
+
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -122,29 +131,58 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     contact = energy.unknowns
     inner_failures = 0
     last_residual = None
-    for it in range(max_iter + 1):
+    it = 0   # Newton iterations (a chord step is part of the one before it)
+    # a chord step on the last Newton system of S first (that of the last
+    # solve with S: the previous level's, or the previous proximal step's
+    # at t = 0), where S keeps one
+    chord = getattr(S, "chord_start", None) if semismooth else None
+    before_chord = None
+    while True:
         st = stationarity(S, c, energy, upper, z, kink)
+        if before_chord is not None:
+            # a chord step is kept where it cut the residual CHORD_GAIN-fold
+            # (the superlinear regime it is for), else its start is
+            if st.residual > CHORD_GAIN * before_chord[2].residual >= tol * st.scale:
+                z, E, st = before_chord
+            before_chord = None
         g, xi, s, at_zero, unit = st.g, st.xi, st.s, st.at_zero, st.unit
         hn, pg, wall, scale, residual = st.hn, st.pg, st.wall, st.scale, st.residual
         status = (CONVERGED if residual <= tol * scale else
-                  MAX_ITERATIONS if it == max_iter else None)
+                  MAX_ITERATIONS if it == max_iter and chord is None else None)
         if status is not None:
             break
 
-        forcing = eisenstat_walker(residual, last_residual) if globalised else 1e-12
+        forcing = (min(eisenstat_walker(residual, last_residual), residual / scale)
+                   if globalised else 1e-12)
+        if chord is not None:
+            # a chord step on the last Newton matrix, counted with its iteration
+            accepted, chord = chord_step(S, upper, z, E, st, kink, chord,
+                                         (forcing, 0.5 * tol * scale), total,
+                                         noise(z, st.Sz), sigma), None
+            if accepted is not None:
+                before_chord = (z, E, st)
+                z, E = accepted
+                continue
+            if it == max_iter:
+                status = MAX_ITERATIONS
+                break
         if semismooth:
             # the semismooth Newton step, its sets free to change; when its
             # line search fails, the held-direction iteration below
-            accepted, solved = semismooth_step(S, energy, upper, z, E, st, kink,
-                                               (forcing, 0.5 * tol * scale),
-                                               total, noise(z, st.Sz), sigma)
+            accepted, solved, chord = semismooth_step(S, energy, upper, z, E, st, kink,
+                                                      (forcing, 0.5 * tol * scale),
+                                                      total, noise(z, st.Sz), sigma)
             inner_failures += not solved
+            if chord is not None and hasattr(S, "chord_start"):
+                S.chord_start = chord   # for the next solve with S too
             if accepted is not None:
                 z, E = accepted
                 last_residual = residual
+                it += 1
                 continue
 
         # identify the sets with a projected-gradient step length ε
+        it += 1
         zc = z[contact]
         width = np.abs(zc - np.minimum(zc - pg[contact] / diag_S[contact],
                                        upper[contact])).max(initial=0.0)
@@ -206,7 +244,7 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             trial = project(z + d)
             E_trial = total(trial)
             size = np.abs(trial).max(initial=0.0)
-            if it == 0:
+            if it == 1:
                 first_size = max(size, np.abs(z).max(initial=0.0), 1e-300)
             if not (np.isfinite(E_trial) and np.all(np.isfinite(trial))
                     and size <= 1e8 * first_size):
@@ -228,6 +266,84 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
                       residual=residual / scale, tolerance=tol, energy=E,
                       inner_failures=inner_failures, multiplier=np.where(wall, -g, 0.0),
                       on_wall=wall, stuck=at_zero)
+
+
+@dataclass
+class ProjectionForm:
+    """The semismooth Newton system of :func:`semismooth_step` at one
+    iterate: its sets, the moves of the held coordinates, the right-hand
+    side and the cone's curvature across ŵ at the slipping nodes (3D)."""
+
+    wall: np.ndarray      # bool per coordinate: put on the wall
+    stick: np.ndarray     # bool per node with a kink: put at ξ = 0
+    fixed: np.ndarray     # bool per coordinate: wall or stick
+    d: np.ndarray         # the held coordinates' moves (0 elsewhere)
+    rhs: np.ndarray       # −∇F, and −J⁻¹(h_a + κ_a ŵ_a) at the slipping nodes
+    across: object        # sparse curvature κ_a/(|w_a| − γ_aκ_a)(I − ŵŵᵀ), or None
+
+
+def projection_form(z, st, upper, gamma, kink, floor):
+    """The sets and the Newton equations of the projection form at z (see
+    :func:`semismooth_step`), with the step lengths ``gamma``."""
+    tan, kappa = kink.tangential, kink.radius
+    g = st.g
+    wall = np.isfinite(upper) & (z - gamma * g >= upper)
+    d = np.zeros(z.size)
+    d[wall] = upper[wall] - z[wall]
+    fixed = wall.copy()
+    rhs = -g
+    stick = np.zeros(tan.shape[0], dtype=bool)
+    across = None
+    if tan.size:
+        xi, h = st.xi, st.h
+        m = tan.shape[1]
+        step = gamma[tan].min(axis=1)
+        w = xi - step[:, None] * h
+        wn = np.linalg.norm(w, axis=1)
+        kinked = kappa > 0
+        stick = kinked & (wn <= step * kappa)
+        slip = kinked & ~stick
+        fixed[tan[stick]] = True
+        d[tan[stick]] = -xi[stick]
+        what = w[slip] / wn[slip][:, None]
+        r = h[slip] + kappa[slip, None] * what
+        if m > 1:
+            # J⁻¹ r and the cone's curvature across ŵ (3D)
+            excess = np.maximum(wn[slip] - step[slip] * kappa[slip], floor)
+            along = np.sum(r * what, axis=1)[:, None] * what
+            r = along + (wn[slip] / excess)[:, None] * (r - along)
+            block = (kappa[slip] / excess)[:, None, None] * (
+                np.eye(m) - what[:, :, None] * what[:, None, :])
+            rows = np.repeat(tan[slip], m, axis=1).ravel()
+            cols = np.tile(tan[slip], (1, m)).ravel()
+            across = sp.csr_matrix((block.ravel(), (rows, cols)), shape=(z.size, z.size))
+        rhs = rhs.copy()
+        rhs[tan[slip]] = -r
+    return ProjectionForm(wall=wall, stick=stick, fixed=fixed, d=d, rhs=rhs, across=across)
+
+
+def armijo_along(z, d, form, E, st, kink, upper, total, slack, sigma, halvings):
+    """The trial points z + αd, α = 1, ½, … (``halvings`` of them), the
+    coordinates ``form`` holds put on the wall or at ξ = 0: the first that
+    passes the Armijo test of the module doc, (z, E, α), or None."""
+    tan, kappa = kink.tangential, kink.radius
+    at_zero = st.at_zero
+    alpha = 1.0
+    for _ in range(halvings):
+        trial = np.minimum(z + alpha * d, upper)
+        trial[form.wall] = upper[form.wall]
+        if tan.size:
+            trial[tan[form.stick]] = 0.0
+        change = trial - z
+        slope = st.g @ change
+        if tan.size:
+            slope += kappa[at_zero] @ np.linalg.norm(change[tan[at_zero]], axis=1)
+        if slope < 0:
+            E_trial = total(trial)
+            if E_trial <= E + sigma * slope + slack:
+                return trial, E_trial, alpha
+        alpha *= 0.5
+    return None
 
 
 def semismooth_step(S, energy, upper, z, E, st, kink, accuracy, total, slack, sigma,
@@ -262,80 +378,68 @@ def semismooth_step(S, energy, upper, z, E, st, kink, accuracy, total, slack, si
 
     A node with a held tangential component (3D, a vertex on a side that
     holds one tangential direction: ``kink.held``) has no projection form
-    here: with such nodes the step is not taken (None, True) and the
+    here: with such nodes the step is not taken (None, True, None) and the
     held-direction iteration does the work.
 
-    Returns ``(accepted, solved)``: ``accepted`` (z, E) or None when no
-    trial passed, ``solved`` False when the Newton system was solved
-    inexactly."""
+    Returns ``(accepted, solved, chord)``: ``accepted`` (z, E) or None when
+    no trial passed, ``solved`` False when the Newton system was solved
+    inexactly, ``chord`` what :func:`chord_step` needs (the step lengths,
+    the sets and the free coordinates) when the full step was taken, else
+    None."""
     if kink.held:
-        return None, True
-    tan, kappa = kink.tangential, kink.radius
-    g = st.g
+        return None, True, None
     zmax = np.abs(z[energy.unknowns]).max(initial=0.0)
     floor = 1e-12 + 1e-8 * zmax
     H = energy.hessian(z, s_floor=floor, kink_free=True).tocsr()
     diagonal = S.diagonal() + H.diagonal()
     gamma = 1.0 / np.where(diagonal > 0, diagonal, np.maximum(S.diagonal(), 1e-300))
-    wall = np.isfinite(upper) & (z - gamma * g >= upper)
-    d = np.zeros(z.size)
-    d[wall] = upper[wall] - z[wall]
-    fixed = wall.copy()
-    rhs = -g
-    stick = np.zeros(tan.shape[0], dtype=bool)
-    if tan.size:
-        xi, h = st.xi, st.h
-        m = tan.shape[1]
-        step = gamma[tan].min(axis=1)
-        w = xi - step[:, None] * h
-        wn = np.linalg.norm(w, axis=1)
-        kinked = kappa > 0
-        stick = kinked & (wn <= step * kappa)
-        slip = kinked & ~stick
-        fixed[tan[stick]] = True
-        d[tan[stick]] = -xi[stick]
-        what = w[slip] / wn[slip][:, None]
-        r = h[slip] + kappa[slip, None] * what
-        if m > 1:
-            # J⁻¹ r and the cone's curvature across ŵ (3D)
-            excess = np.maximum(wn[slip] - step[slip] * kappa[slip], floor)
-            along = np.sum(r * what, axis=1)[:, None] * what
-            r = along + (wn[slip] / excess)[:, None] * (r - along)
-            across = (kappa[slip] / excess)[:, None, None] * (
-                np.eye(m) - what[:, :, None] * what[:, None, :])
-            rows = np.repeat(tan[slip], m, axis=1).ravel()
-            cols = np.tile(tan[slip], (1, m)).ravel()
-            H = H + sp.csr_matrix((across.ravel(), (rows, cols)), shape=H.shape)
-        rhs = rhs.copy()
-        rhs[tan[slip]] = -r
-    free = ~fixed
+    form = projection_form(z, st, upper, gamma, kink, floor)
+    if form.across is not None:
+        H = H + form.across
+    d = form.d
+    free = ~form.fixed
     solved = True
     if free.any():
-        moved = np.where(fixed, d, 0.0)
-        right = rhs[free] - ((S @ moved)[free] + (H @ moved)[free])
+        moved = np.where(form.fixed, d, 0.0)
+        right = form.rhs[free] - ((S @ moved)[free] + (H @ moved)[free])
         d[free], solved = S.newton_solve(H, right, free, accuracy=accuracy)
+    accepted = armijo_along(z, d, form, E, st, kink, upper, total, slack, sigma, halvings)
+    if accepted is None:
+        return None, solved, None
+    trial, E_trial, alpha = accepted
+    chord = ((gamma, form, free, floor, getattr(S, "kept", None))
+             if alpha == 1.0 and free.any() else None)
+    return (trial, E_trial), solved, chord
 
-    def project(trial):
-        trial = np.minimum(trial, upper)
-        trial[wall] = upper[wall]
-        if tan.size:
-            trial[tan[stick]] = 0.0
-        return trial
 
-    at_zero = st.at_zero
-    alpha = 1.0
-    for _ in range(halvings):
-        trial = project(z + alpha * d)
-        change = trial - z
-        slope = g @ change
-        if tan.size:
-            slope += kappa[at_zero] @ np.linalg.norm(change[tan[at_zero]], axis=1)
-        if slope < 0:
-            E_trial = total(trial)
-            if E_trial <= E + sigma * slope + slack:
-                return (trial, E_trial), solved
-        alpha *= 0.5
-    return None, solved
+def chord_step(S, upper, z, E, st, kink, chord, accuracy, total, slack, sigma):
+    """The chord step after a full semismooth step: the Newton equations of
+    the projection form at the new z solved with the matrix of the last
+    step, its factorisation reused (``S.chord_solve``), when z has the sets
+    of that step (then the step is the simplified Newton step of a smooth
+    system, and takes the superlinear error e of the last step to about
+    ‖∂²F(z) − ∂²F(z_prev)‖ e: of the nonlinearity of the contact terms
+    along it, e.g. a newly slipping node's slip weakening). Its full step
+    only, by the Armijo test of the module doc: (z, E) or None (no chord
+    solve for this matrix, other sets, or no decrease)."""
+    solve = getattr(S, "chord_solve", None)
+    gamma, last, free, floor, system = chord
+    if solve is None:
+        return None
+    form = projection_form(z, st, upper, gamma, kink, floor)
+    if not (np.array_equal(form.fixed, last.fixed) and np.array_equal(form.wall, last.wall)):
+        return None
+    d = np.zeros(z.size)
+    step = solve(form.rhs[free], free, accuracy=accuracy, system=system)
+    if step is None:
+        return None
+    d[free] = step
+    accepted = armijo_along(z, d, form, E, st, kink, upper, total, slack, sigma, 1)
+    return None if accepted is None else accepted[:2]
+
+
+#: a chord step is kept when it divides the residual by at least this
+CHORD_GAIN = 0.3
 
 
 def eisenstat_walker(residual, last, gamma=0.9, largest=0.1):
@@ -346,6 +450,9 @@ def eisenstat_walker(residual, last, gamma=0.9, largest=0.1):
     While the sets move and the residual falls slowly, a rough direction is
     as good as an exact one; once Newton converges, η_k falls with the
     residual and the convergence stays superlinear.
+    The caller caps η_k at the relative residual (Dembo, Eisenstat and
+    Steihaug's η_k = O(‖F_k‖)), so that a start near the solution (the
+    predictor's) is not followed by a rough first step.
     (``largest`` 0.1 against 0.5 on the 3D ladder with AMG: 2.75 against
     3.35 s of stepping at 1e4 dofs frictionless, 12.0 against 14.3 s at
     2.8e4 dofs full model, the same at 1.1e5 dofs.)"""

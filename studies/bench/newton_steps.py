@@ -13,6 +13,10 @@ dofs, 50 steps; the 3D block, 1.09e5 dofs, 20 steps), run in-process with
   move ("moving": a contact node changes state — separated, compliance,
   wall, stick, slip — or crosses the glue's reach L in u_ν or |u_τ|,
   read off the fields of the level and the one before) and over the rest;
+- the Newton systems solved (factorised, or AMG-preconditioned afresh:
+  one an iteration, two where the semismooth step is refused) and the
+  chord solves with a kept one (docs/scheme.md, "Step methods"), which
+  the iterations do not count;
 - the share of the step method's seconds (``timings.contact_solve``) in
   the Newton systems (``newton_solve``: factorisations and solves, minus
   the AMG hierarchy's updates), in those updates, in the Hessian of Φ,
@@ -47,7 +51,8 @@ SCENES = {"strip": (HERE / "ratio" / "strip_full.toml", {}),
                       "time": {"T": 0.5, "steps": 10}})}
 FIELDS = ("tag", "scene", "scale", "dofs", "contact_unknowns", "steps", "linear", "t0",
           "mean", "max", "moving_steps", "moving_mean", "moving_max", "quiet_mean",
-          "total_iterations", "contact_solve_s", "stepping_s", "share_newton_solve",
+          "total_iterations", "newton_systems", "chord_solves", "contact_solve_s",
+          "stepping_s", "share_newton_solve",
           "share_updates", "share_hessian", "share_products", "share_line_search",
           "share_residual", "share_other")
 
@@ -58,6 +63,7 @@ class Profile:
     def __init__(self):
         self.seconds = {}
         self.stack = []
+        self.calls = {}   # category -> calls that returned something (not None)
 
     def wrap(self, owner, name, category):
         inner = getattr(owner, name)
@@ -67,7 +73,10 @@ class Profile:
             profile.stack.append(0.0)
             t0 = time.perf_counter()
             try:
-                return inner(*args, **kwargs)
+                out = inner(*args, **kwargs)
+                if out is not None:
+                    profile.calls[name] = profile.calls.get(name, 0) + 1
+                return out
             finally:
                 spent = time.perf_counter() - t0
                 children = profile.stack.pop()
@@ -87,13 +96,16 @@ def instrument(profile):
 
     for cls in (condensed.DenseSchur, condensed.ImplicitSchur, full_system.FullSystemMatrix):
         profile.wrap(cls, "newton_solve", "newton_solve")
+        if hasattr(cls, "chord_solve"):   # the chord steps' solves with the same matrix
+            profile.wrap(cls, "chord_solve", "newton_solve")
     profile.wrap(AMGSolver, "updated", "updates")
     profile.wrap(ContactEnergy, "hessian", "hessian")
     profile.wrap(condensed.RememberedProduct, "__matmul__", "products")
     profile.wrap(condensed.ImplicitSchur, "__matmul__", "products")
     profile.wrap(newton, "backtrack", "line_search")
-    if hasattr(newton, "semismooth_step"):   # its sets and its line search
-        profile.wrap(newton, "semismooth_step", "line_search")
+    for name in ("semismooth_step", "chord_step"):   # their sets and line searches
+        if hasattr(newton, name):
+            profile.wrap(newton, name, "line_search")
     profile.wrap(newton, "stationarity", "residual")
     for name in ("update_factor", "bordered_solve"):   # factor updates, where the code has them
         for cls in (condensed.DenseSchur,):
@@ -153,7 +165,9 @@ def measure(name, scale, tag):
            "moving_mean": float(steps_it[moving].mean()) if moving.any() else 0.0,
            "moving_max": int(steps_it[moving].max()) if moving.any() else 0,
            "quiet_mean": float(steps_it[~moving].mean()) if (~moving).any() else 0.0,
-           "total_iterations": int(it.sum()), "contact_solve_s": solve_s,
+           "total_iterations": int(it.sum()),
+           "newton_systems": profile.calls.get("newton_solve", 0),
+           "chord_solves": profile.calls.get("chord_solve", 0), "contact_solve_s": solve_s,
            "stepping_s": solution.timings["stepping"]}
     for key in ("newton_solve", "updates", "hessian", "products", "line_search", "residual"):
         row[f"share_{key}"] = shares.get(key, 0.0)
@@ -188,7 +202,8 @@ def main():
               f"{row['contact_unknowns']} contact unknowns, {row['linear']}): t = 0 {row['t0']}; "
               f"steps mean {row['mean']:.2f}, max {row['max']}; moving ({row['moving_steps']} "
               f"steps) {row['moving_mean']:.2f} max {row['moving_max']}, quiet "
-              f"{row['quiet_mean']:.2f}; step method {row['contact_solve_s']:.2f} s: Newton "
+              f"{row['quiet_mean']:.2f}; {row['newton_systems']} Newton systems and "
+              f"{row['chord_solves']} chord solves; step method {row['contact_solve_s']:.2f} s: Newton "
               f"systems {row['share_newton_solve']:.0%}, updates {row['share_updates']:.0%}, "
               f"Hessian {row['share_hessian']:.0%}, products {row['share_products']:.0%}, line "
               f"search {row['share_line_search']:.0%}, residual {row['share_residual']:.0%}, "
