@@ -11,7 +11,7 @@ from pathlib import Path
 
 import click
 
-from .common import CliError, load_scene, read_scene, scene_folder
+from .common import CliError, load_scene, read_scene, scene_folder, time_line
 
 
 @click.command()
@@ -37,7 +37,7 @@ def check(scene, resolved):
         click.echo(f"{name}: valid scene ({parsed.title}), too large to build here: {reason}")
         if est is not None:
             click.echo(f"  estimate: {est.describe()}")
-        click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}")
+        click.echo(f"  time: {time_line(parsed)}")
         click.echo("  not built: the mesh, contact and smallness figures need the problem; "
                    "check a coarser scene (mesh.cells, mesh.refine)")
         return
@@ -50,8 +50,7 @@ def check(scene, resolved):
                + ("no contact boundary" if boundary is None else
                   f"{boundary.facets.size} contact facets, {boundary.nodes.size} contact "
                   f"nodes, {problem.columns.size} contact unknowns"))
-    scheme = "" if parsed.scheme == "paper" else f" ({parsed.scheme} scheme)"
-    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}{scheme}")
+    click.echo(f"  time: {time_line(parsed)}")
     click.echo(f"  estimate: {est.describe()}")
     if getattr(problem.bonding, "rate_independent", False):
         from adhesive_contact.problem.warnings import DAMAGE_DROP

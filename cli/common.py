@@ -14,6 +14,7 @@ from importlib import resources
 from pathlib import Path
 
 import click
+import numpy as np
 
 DEFAULT_SCENE = "default_scene.toml"
 
@@ -211,3 +212,19 @@ def running_study(out, executor, saved):
     finally:
         if executor is not None:
             executor.close()
+
+
+def time_line(scene, solution=None):
+    """The "time:" line of ``solve`` and ``check``: the uniform grid, or for
+    ``[time.adaptive]`` the tolerance and, after a run, the steps it took."""
+    scheme = "" if scene.scheme == "paper" else f" ({scene.scheme} scheme)"
+    if scene.adaptive is None:
+        return f"{scene.steps} steps of k = {scene.k:g} to T = {scene.T:g}{scheme}"
+    if solution is None or solution.t.size < 2:
+        return (f"adaptive steps (time.adaptive.tol = {scene.adaptive.tol:g}), k at most "
+                f"{scene.k:g}, to T = {scene.T:g}{scheme}")
+    k = np.diff(solution.t)
+    rejected = (solution.adaptive or {}).get("rejected_pairs", 0)
+    return (f"{k.size} adaptive steps (time.adaptive.tol = {scene.adaptive.tol:g}) of k = "
+            f"{k.min():.3g} to {k.max():.3g}, {rejected} pairs rejected, to T = "
+            f"{scene.T:g}{scheme}")

@@ -35,6 +35,7 @@ from .common import (
     load_scene,
     read_scene,
     scene_folder,
+    time_line,
 )
 
 #: commands imported only when run (the library, matplotlib and dask take a
@@ -193,7 +194,8 @@ def solve_command(scene, out, force, quiet):
             try:
                 with click.progressbar(length=parsed.steps + 1,
                                        file=io.StringIO() if quiet else sys.stderr,
-                                       label=f"{name}: {parsed.steps} steps",
+                                       label=(f"{name}: adaptive steps" if parsed.adaptive is not None
+                                              else f"{name}: {parsed.steps} steps"),
                                        item_show_func=lambda level: level_status(level)) \
                         as bar, interruptible() as interrupted:
                     solution = solve(problem, recorder=recorder,
@@ -237,8 +239,7 @@ def solve_command(scene, out, force, quiet):
     click.echo(f"{parsed.title}")
     click.echo(f"  mesh: {mesh.p.shape[1]} nodes, {mesh.t.shape[1]} cells, "
                f"{problem.ndofs} dofs ({problem.free.size} free), {contact}")
-    scheme = "" if parsed.scheme == "paper" else f" ({parsed.scheme} scheme)"
-    click.echo(f"  time: {parsed.steps} steps of k = {parsed.k:g} to T = {parsed.T:g}{scheme}, "
+    click.echo(f"  time: {time_line(parsed, solution)}, "
                f"{int(solution.iterations.sum())} solver iterations, "
                f"{solution.timings['total']:.2f} s")
     if boundary is not None and boundary.facets.size:

@@ -309,6 +309,21 @@ def test_solve_writes_the_nonuniform_grid(tmp_path):
     assert loaded.problem.times.size == t.size
 
 
+def test_solve_and_check_say_the_steps_an_adaptive_run_took(tmp_path):
+    result, out = solve_scene(tmp_path, strip(tol=0.2))
+    assert result.exit_code == 0, (result.output, result.exception)
+    with np.load(out / "solution.npz") as data:
+        k = np.diff(data["t"])
+    rejected = json.loads((out / "summary.json").read_text())["adaptive"]["rejected_pairs"]
+    (line,) = [s for s in result.output.splitlines() if s.startswith("  time:")]
+    assert line.startswith(f"  time: {k.size} adaptive steps (time.adaptive.tol = 0.2) of "
+                           f"k = {k.min():.3g} to {k.max():.3g}, {rejected} pairs rejected, "
+                           f"to T = 1, ")
+    checked = invoke("check", tmp_path / "scene.toml")
+    assert "  time: adaptive steps (time.adaptive.tol = 0.2), k at most 0.125, to T = 1\n" \
+        in checked.output
+
+
 @pytest.mark.parametrize("change, needle", [
     ({"tol": 0.0}, "time.adaptive.tol: must lie in [1e-08, 1]"),
     ({"k_min": 0.1}, "time.adaptive.k_min: must be at most k_max/2 = 0.0625"),
