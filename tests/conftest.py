@@ -306,3 +306,23 @@ def counting(monkeypatch):
     monkeypatch.setattr(converge_module, "run_level", run_level)
     monkeypatch.setattr(converge_module, "run_reference", run_reference)
     return calls
+
+
+#: the standard linear solid of the held-strain tests: E_∞ + E_1 e^{−t/τ}, τ = 1, ν = 0
+SLS_E_INF, SLS_E_1, SLS_STRAIN = 500.0, 500.0, 1e-3
+
+
+def held_strain_run(steps, T, scheme):
+    """A 4 × 1 bar of the standard linear solid SLS_* stretched by SLS_STRAIN
+    at t = 0 and held to T in ``steps`` steps of ``time.scheme``: the
+    solution (σ_xx is uniform in every cell)."""
+    _, solution = run(scene_dict({
+        "mesh.size": [4.0, 1.0], "mesh.cells": [4, 1],
+        "boundary": {"dirichlet": [], "displacement": {
+            "left": ["0", "free"], "right": [repr(4.0 * SLS_STRAIN), "free"],
+            "bottom": ["free", "0"]}},
+        "material": DELETE,
+        "memory": {"kernel": "relaxation", "long_term": {"E": SLS_E_INF, "nu": 0.0},
+                   "terms": [{"E": SLS_E_1, "tau": 1.0}]},
+        "time": {"T": T, "steps": steps, "scheme": scheme}}))
+    return solution

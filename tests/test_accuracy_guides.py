@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import DELETE, run, scene_dict, to_toml
+from conftest import (SLS_E_1, SLS_E_INF, SLS_STRAIN, held_strain_run, scene_dict,
+                      to_toml)
 
 from adhesive_contact import build_problem, load_scene, parse_scene, scene_from_dict, solve
 from adhesive_contact.laws.bonding import BEYOND_TIME_SCALE
@@ -26,21 +27,13 @@ MEMORY = "puts the stress of a strain held from t = 0 off by"
 TIME_SCALE = "times the explicit Euler bound 1/((gamma_nu + gamma_tau) L^2) ="
 STOPS = "so beta may leave [0, 1] and the run stop"
 
-E_INF, E_1, STRAIN = 500.0, 500.0, 1e-3
+E_INF, E_1, STRAIN = SLS_E_INF, SLS_E_1, SLS_STRAIN
 
 
 def held_strain(ratio, scheme, held=40.0):
     """The standard linear solid E_∞ + E_1 e^{−t}, ν = 0, stretched at t = 0
     and held to T = ``held`` at k = ``ratio``: (scene, σ_xx(T)/ε of the run)."""
-    sol = run(scene_dict({
-        "mesh.size": [4.0, 1.0], "mesh.cells": [4, 1],
-        "boundary": {"dirichlet": [], "displacement": {
-            "left": ["0", "free"], "right": [repr(4.0 * STRAIN), "free"],
-            "bottom": ["free", "0"]}},
-        "material": DELETE,
-        "memory": {"kernel": "relaxation", "long_term": {"E": E_INF, "nu": 0.0},
-                   "terms": [{"E": E_1, "tau": 1.0}]},
-        "time": {"T": held, "steps": int(round(held / ratio)), "scheme": scheme}}))[1]
+    sol = held_strain_run(int(round(held / ratio)), held, scheme)
     assert sol.success
     return sol.problem.scene, float(sol.stress[-1, :, 0, 0].mean()) / STRAIN
 

@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import DELETE, assert_refused, prony, run, scene_dict, solve_scene
+from conftest import (SLS_E_1, SLS_E_INF, SLS_STRAIN, assert_refused, held_strain_run, prony,
+                      run, scene_dict, solve_scene)
 from scipy.integrate import solve_ivp
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
@@ -315,19 +316,11 @@ def test_k_study_second_order_where_the_paper_is_first_order():
 # + ½], which tends to E_∞ − E_1 ((c/2) coth(c/2) − 1): 2.1 % of E_∞ too low
 # at k/τ = 0.5 (the paper's rule: E_1 (c/(1 − e^{−c}) − 1), 27 %).
 
-E_INF, E_1, STRAIN = 500.0, 500.0, 0.001
+E_INF, E_1, STRAIN = SLS_E_INF, SLS_E_1, SLS_STRAIN
 
 
 def relaxation_stress(steps, T, scheme):
-    _, sol = run(scene_dict({
-        "mesh.size": [4.0, 1.0], "mesh.cells": [4, 1],
-        "boundary": {"dirichlet": [], "displacement": {
-            "left": ["0", "free"], "right": [repr(4.0 * STRAIN), "free"],
-            "bottom": ["free", "0"]}},
-        "material": DELETE,
-        "memory": {"kernel": "relaxation", "long_term": {"E": E_INF, "nu": 0.0},
-                   "terms": [{"E": E_1, "tau": 1.0}]},
-        "time": {"T": T, "steps": steps, "scheme": scheme}}))
+    sol = held_strain_run(steps, T, scheme)
     return sol.stress[:, :, 0, 0].mean(axis=1)   # uniform: σ_xx in every cell
 
 
