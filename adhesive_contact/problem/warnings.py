@@ -174,11 +174,10 @@ def held_by_contact_warning(problem):
 
 
 def explicit_bound_warning(problem):
-    """A line when the step exceeds the explicit Euler bound of the bonding
-    law (never with ``[time.adaptive]``, whose steps stay below the bound)."""
+    """A line when the step exceeds the explicit Euler bound of the bonding law."""
     scene = problem.scene
     if (problem.bonding is None or scene.contact.integrator != "explicit"
-            or scene.adaptive is not None or scene.k <= problem.bonding.stable_step()):
+            or scene.k <= problem.bonding.stable_step()):
         return None
     return (f"the time step k = {scene.k:.4g} exceeds the explicit Euler bound "
             f"1/((gamma_nu + gamma_tau) L^2) = {problem.bonding.stable_step():.4g} of "
@@ -192,12 +191,10 @@ def time_scale_warning(problem):
     """A line when an integrator other than explicit Euler (which has
     :func:`explicit_bound_warning`) runs at a step beyond the bonding law's
     time scale 1/((γ_ν + γ_τ) L²): stable, but the debonding front lags
-    (:mod:`.accuracy`). Not with ``[time.adaptive]``: its error control
-    chooses the steps."""
+    (:mod:`.accuracy`)."""
     scale = bonding_time_scale(problem)
     scene = problem.scene
-    if (scale is None or scene.contact.integrator == "explicit" or scene.adaptive is not None
-            or scene.k <= scale):
+    if scale is None or scene.contact.integrator == "explicit" or scene.k <= scale:
         return None
     return (f"the time step k = {scene.k:.4g} is {scene.k / scale:.3g} times the explicit "
             f"Euler bound 1/((gamma_nu + gamma_tau) L^2) = {scale:.4g} of the bonding law: "
@@ -213,11 +210,8 @@ MEMORY_RULES = {"paper": "right rectangle rule", "second-order": "trapezoidal ru
 def memory_step_warning(problem):
     """A line when the memory's quadrature at the scene's k puts the stress
     of a strain held from t = 0 off by more than MEMORY_GUIDE at T
-    (:func:`.accuracy.memory_error`). Not with ``[time.adaptive]``: its
-    error control chooses the steps."""
+    (:func:`.accuracy.memory_error`)."""
     scene = problem.scene
-    if scene.adaptive is not None:
-        return None
     error = memory_error(scene)
     if error is None or error <= MEMORY_GUIDE:
         return None
@@ -290,10 +284,17 @@ def stiffness_warning(problem):
                if ratio > 1 else "(the foundation barely holds the body)"))
 
 
+#: the warnings on the uniform step k = T/N; a scene with ``[time.adaptive]``
+#: gets none of them: its steps are chosen by its tol and kept below the
+#: explicit Euler bound, k = T/N is only the largest
+STEP_WARNINGS = (explicit_bound_warning, time_scale_warning, memory_step_warning)
+
+
 def problem_warnings(problem):
     """The lines of the checks of a scene that apply, before a run."""
-    return [w for w in (held_by_contact_warning(problem), explicit_bound_warning(problem),
-                        time_scale_warning(problem), memory_step_warning(problem),
+    steps = STEP_WARNINGS if problem.scene.adaptive is None else ()
+    return [w for w in (held_by_contact_warning(problem),
+                        *(warning(problem) for warning in steps),
                         stiffness_warning(problem))
             if w is not None] + plausibility_warnings(problem.scene)
 

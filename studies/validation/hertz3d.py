@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from adhesive_contact import build_problem, scene_from_dict, solve
+from adhesive_contact.postprocess import normal_traction
 from adhesive_contact.storage import saved_or_computed, write_csv
 
 HERE = Path(__file__).resolve().parent
@@ -59,19 +60,6 @@ def hertz(P, E_star):
     return a, 3.0 * P / (2.0 * np.pi * a ** 2)
 
 
-def lumped_weights(problem):
-    """w_a = ∫_{Γ_C} φ_a (a third of each contact triangle's area to its
-    vertices), in the order of ``problem.boundary.nodes``."""
-    boundary = problem.boundary
-    x = problem.mesh.p[:, boundary.facet_nodes]               # (3, 3, m)
-    area = 0.5 * np.linalg.norm(np.cross((x[:, 1] - x[:, 0]).T, (x[:, 2] - x[:, 0]).T), axis=1)
-    local = np.searchsorted(boundary.nodes, boundary.facet_nodes)
-    w = np.zeros(boundary.nodes.size)
-    for v in range(3):
-        np.add.at(w, local[v], area / 3.0)
-    return w
-
-
 def measure(problem, solution, n):
     """The Hertz quantities of time level n of a run (a dict of COLUMNS)."""
     material = problem.scene.material
@@ -80,7 +68,7 @@ def measure(problem, solution, n):
     r2 = X[0] ** 2 + X[1] ** 2
     axis = int(np.argmin(r2))
     F = -solution.contact_force[n, :, 0]                   # compressive normal forces
-    w = lumped_weights(problem)
+    pressure = normal_traction(solution)[n]                # F_a / w_a, w_a = ∫ φ_a
     P = 4.0 * F.sum()                                      # the quarter model's four times
     a, p0 = hertz(P, E_star)
     a_moment = np.sqrt(2.5 * (F @ r2) / F.sum())
@@ -89,8 +77,8 @@ def measure(problem, solution, n):
     last = np.flatnonzero(solution.on_wall[n, on_x]).max()
     return {"t": float(solution.t[n]), "P": float(P), "a_over_R": float(a / R),
             "a_hertz": float(a), "a_moment": float(a_moment), "err_a": float(a_moment / a - 1),
-            "p0_hertz": float(p0), "p0": float(F[axis] / w[axis]),
-            "err_p0": float(F[axis] / w[axis] / p0 - 1),
+            "p0_hertz": float(p0), "p0": float(pressure[axis]),
+            "err_p0": float(pressure[axis] / p0 - 1),
             "a_bracket_lo": float(X[0, on_x[last]]), "a_bracket_hi": float(X[0, on_x[last + 1]])}
 
 
