@@ -538,8 +538,10 @@ def test_a_mesh_file_cut_short_is_one_line_without_meshios_warnings(tmp_path):
         "error: mesh.file: cannot read 'm.msh' as a mesh: "), result.stderr
 
 
-def test_a_part_of_the_mesh_held_by_no_side_is_refused(tmp_path):
-    # two strips in one file, only the first hung from its top: a singular factor
+def two_strips(tmp_path):
+    """Two strips of :func:`strip_mesh` side by side in one file m.msh
+    (x ∈ [0, 2] and [3, 5]), their feet named "foot", the top of the first
+    only named "top"; the mesh."""
     from skfem import MeshTri
 
     a = strip_mesh()
@@ -548,6 +550,12 @@ def test_a_part_of_the_mesh_held_by_no_side_is_refused(tmp_path):
     both = both.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0) & (x[0] < 2.5),
                                  "foot": lambda x: np.isclose(x[1], 0.0)})
     write_msh(tmp_path / "m.msh", both, ["top", "foot"])
+    return both
+
+
+def test_a_part_of_the_mesh_held_by_no_side_is_refused(tmp_path):
+    # two strips in one file, only the first hung from its top: a singular factor
+    both = two_strips(tmp_path)
     scene = scene_from_dict(file_scene(tmp_path / "m.msh"))
     with pytest.raises(SceneError, match=r"^boundary: the part of the mesh around \(4, 0\.5\) "
                                          r"\(15 nodes, not connected to the rest\): the held "
@@ -567,14 +575,7 @@ def test_the_contact_terms_hold_a_part_of_the_mesh_on_its_own(tmp_path):
     compliant foot: the layer holds the second strip's vertical translation
     and rotation but not its slide along x, which is refused naming that
     part; with Tresca friction on the foot as well, nothing is free."""
-    from skfem import MeshTri
-
-    a = strip_mesh()
-    both = MeshTri(np.hstack([a.p, a.p + np.array([[3.0], [0.0]])]),
-                   np.hstack([a.t, a.t + a.p.shape[1]]))
-    both = both.with_boundaries({"top": lambda x: np.isclose(x[1], 1.0) & (x[0] < 2.5),
-                                 "foot": lambda x: np.isclose(x[1], 0.0)})
-    write_msh(tmp_path / "m.msh", both, ["top", "foot"])
+    two_strips(tmp_path)
     layer = {"contact.normal": law("compliance", c=100.0)}
     with pytest.raises(SceneError, match=r"^boundary: the part of the mesh around \(4, 0\.5\) "
                                          r"\(15 nodes, not connected to the rest\): the held "
