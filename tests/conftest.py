@@ -326,3 +326,27 @@ def held_strain_run(steps, T, scheme):
                    "terms": [{"E": SLS_E_1, "tau": 1.0}]},
         "time": {"T": T, "steps": steps, "scheme": scheme}}))
     return solution
+
+
+#: the start of a script run in a subprocess that SIGKILLs itself at move
+#: number ``sys.argv[2]`` (os.replace and os.rename counted from 0) and
+#: imports ``adhesive_contact.folders`` alone (it needs storage.py only: the
+#: package's slow __init__ is skipped); ``target`` is ``sys.argv[1]``, and
+#: ``calls[0]`` counts the moves made
+KILL_AT_MOVE = """
+import importlib.util, json, os, signal, sys, types
+package = types.ModuleType("adhesive_contact")
+package.__path__ = importlib.util.find_spec("adhesive_contact").submodule_search_locations
+sys.modules["adhesive_contact"] = package
+from adhesive_contact import folders
+target, kill_at = sys.argv[1], int(sys.argv[2])
+calls = [0]
+def counted(real):
+    def move(*args, **kwargs):
+        if calls[0] == kill_at:
+            os.kill(os.getpid(), signal.SIGKILL)
+        calls[0] += 1
+        return real(*args, **kwargs)
+    return move
+os.replace, os.rename = counted(os.replace), counted(os.rename)
+"""

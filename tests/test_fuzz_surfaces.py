@@ -28,7 +28,7 @@ import distributed  # noqa: F401  (imported here, so that no timing below includ
 import meshio
 import numpy as np
 import pytest
-from conftest import DELETE, law, runner, scene_dict, to_toml
+from conftest import DELETE, KILL_AT_MOVE, law, runner, scene_dict, to_toml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -272,23 +272,8 @@ def test_fuzz_schedulers(data, close):
 # ---------------------------------------------------------------- output folders under faults
 
 NAMES = ["summary.json", "solution.h5", "solution.npz", "beta.png", "contact_map.png"]
-KILLED = textwrap.dedent("""
-    import importlib.util, os, signal, sys, types, json
-    package = types.ModuleType("adhesive_contact")
-    package.__path__ = importlib.util.find_spec("adhesive_contact").submodule_search_locations
-    sys.modules["adhesive_contact"] = package
-    from adhesive_contact import folders
-    target, kill_at, new, limit = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3]), \\
-        int(sys.argv[4])
-    calls = [0]
-    def counted(real):
-        def move(*args, **kwargs):
-            if calls[0] == kill_at:
-                os.kill(os.getpid(), signal.SIGKILL)
-            calls[0] += 1
-            return real(*args, **kwargs)
-        return move
-    os.replace, os.rename = counted(os.replace), counted(os.rename)
+KILLED = KILL_AT_MOVE + textwrap.dedent("""
+    new, limit = json.loads(sys.argv[3]), int(sys.argv[4])
     if limit:
         import resource
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))

@@ -23,7 +23,7 @@ from adhesive_contact import load_solution
 from adhesive_contact.folders import MARKER, FolderLock, publish, read_marker, recover
 from adhesive_contact.storage import remove_stale_temporaries
 from adhesive_contact_cli.main import main
-from conftest import law, runner, scene_dict, to_toml
+from conftest import KILL_AT_MOVE, law, runner, scene_dict, to_toml
 
 CLI = "from adhesive_contact_cli.main import main; main()"
 
@@ -198,23 +198,7 @@ NEW = {"summary.json": "new", "solution.h5": "new h5", "solution.npz": "new npz"
        "beta.png": "new beta"}
 OUTPUTS = sorted(set(OLD) | set(NEW))
 
-KILLED_PUBLISH = textwrap.dedent("""
-    import importlib.util, os, signal, sys, types
-    # folders.py needs storage.py alone: skip the package's (slow) __init__
-    package = types.ModuleType("adhesive_contact")
-    package.__path__ = importlib.util.find_spec("adhesive_contact").submodule_search_locations
-    sys.modules["adhesive_contact"] = package
-    from adhesive_contact import folders
-    target, kill_at = sys.argv[1], int(sys.argv[2])
-    calls = [0]
-    def counted(real):
-        def move(*args, **kwargs):
-            if calls[0] == kill_at:
-                os.kill(os.getpid(), signal.SIGKILL)
-            calls[0] += 1
-            return real(*args, **kwargs)
-        return move
-    os.replace, os.rename = counted(os.replace), counted(os.rename)
+KILLED_PUBLISH = KILL_AT_MOVE + textwrap.dedent("""
     with folders.staged_folder(target, {outputs!r}) as staging:
         for name, text in {new!r}.items():
             (staging / name).write_text(text)
