@@ -350,3 +350,41 @@ def counted(real):
     return move
 os.replace, os.rename = counted(os.replace), counted(os.rename)
 """
+
+
+class Listener:
+    """A loopback TCP listener that is no dask scheduler, started here and
+    stopped by ``close()``: it accepts, sends ``data`` (nothing: silent, as
+    an HTTP server waiting for a request is) and, with ``close``, closes the
+    connection at once."""
+
+    def __init__(self, data=b"", close=False):
+        import socket
+        import threading
+
+        self.data, self.close_after, self.sockets = data, close, []
+        self.server = socket.socket()
+        self.server.bind(("127.0.0.1", 0))
+        self.server.listen(8)
+        self.address = f"tcp://127.0.0.1:{self.server.getsockname()[1]}"
+        threading.Thread(target=self.serve, daemon=True).start()
+
+    def serve(self):
+        while True:
+            try:
+                conn, _ = self.server.accept()
+            except OSError:
+                return
+            self.sockets.append(conn)
+            try:
+                if self.data:
+                    conn.sendall(self.data)
+                if self.close_after:
+                    conn.close()
+            except OSError:
+                pass
+
+    def close(self):
+        self.server.close()
+        for conn in self.sockets:
+            conn.close()

@@ -9,7 +9,6 @@ import csv
 import json
 import os
 import socket
-import threading
 import time
 from pathlib import Path
 from types import SimpleNamespace
@@ -17,7 +16,8 @@ from types import SimpleNamespace
 import dask
 import pytest
 from adhesive_contact_cli.main import main
-from conftest import assert_one_line_error, law, prony, runner, scene_dict, to_toml, wall_block
+from conftest import (Listener, assert_one_line_error, law, prony, runner, scene_dict, to_toml,
+                      wall_block)
 from distributed import LocalCluster
 
 import adhesive_contact.studies.executors as executors
@@ -290,37 +290,10 @@ def test_help_documents_scheduler():
 # ---------------------------------------------------------------- listeners that are not schedulers
 
 
-class Listener:
-    """A loopback TCP listener the test starts and stops: ``silent`` accepts
-    and says nothing, ``http`` reads a request and waits (as an HTTP server
-    does before it answers), ``garbage`` sends bytes that are no handshake,
-    ``closes`` accepts and closes at once."""
-
-    def __init__(self, kind):
-        self.kind, self.sockets = kind, []
-        self.server = socket.socket()
-        self.server.bind(("127.0.0.1", 0))
-        self.server.listen(8)
-        self.address = f"tcp://127.0.0.1:{self.server.getsockname()[1]}"
-        self.thread = threading.Thread(target=self.serve, daemon=True)
-        self.thread.start()
-
-    def serve(self):
-        while True:
-            try:
-                conn, _ = self.server.accept()
-            except OSError:
-                return
-            self.sockets.append(conn)
-            if self.kind == "garbage":
-                conn.sendall(b"\xff" * 64 + b"HTTP/1.1 400 Bad Request\r\n\r\n")
-            elif self.kind == "closes":
-                conn.close()
-
-    def close(self):
-        self.server.close()
-        for conn in self.sockets:
-            conn.close()
+#: the listeners of the tests below: (what it sends, whether it closes at once)
+LISTENERS = {"silent": (b"", False), "http": (b"", False),
+             "garbage": (b"\xff" * 64 + b"HTTP/1.1 400 Bad Request\r\n\r\n", False),
+             "closes": (b"", True)}
 
 
 @pytest.mark.parametrize("kind, needle", [
@@ -334,7 +307,7 @@ class Listener:
                "scheduler within 1 s"),
 ])
 def test_a_listener_that_is_not_a_scheduler_is_refused_within_the_timeout(kind, needle):
-    listener = Listener(kind)
+    listener = Listener(*LISTENERS[kind])
     try:
         started = time.monotonic()
         with pytest.raises(ClusterError) as info:
@@ -346,7 +319,7 @@ def test_a_listener_that_is_not_a_scheduler_is_refused_within_the_timeout(kind, 
 
 
 def test_a_silent_listener_is_one_line_exit_2_within_5_s(scenes, tmp_path):
-    listener = Listener("silent")
+    listener = Listener()
     try:
         for command, args in (("sweep", GRID), ("converge", ("--param", "k", "--levels", 2))):
             started = time.monotonic()

@@ -17,18 +17,16 @@ import json
 import math
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import textwrap
-import threading
 import time
 
 import distributed  # noqa: F401  (imported here, so that no timing below includes it)
 import meshio
 import numpy as np
 import pytest
-from conftest import DELETE, KILL_AT_MOVE, law, runner, scene_dict, to_toml
+from conftest import DELETE, KILL_AT_MOVE, Listener, law, runner, scene_dict, to_toml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -222,43 +220,10 @@ def test_fuzz_set_values(text):
 # ---------------------------------------------------------------- schedulers
 
 
-class ByteListener:
-    """A loopback listener that sends ``data`` to whoever connects (then, if
-    ``close``, closes), started and stopped by the test."""
-
-    def __init__(self, data, close):
-        self.server = socket.socket()
-        self.server.bind(("127.0.0.1", 0))
-        self.server.listen(4)
-        self.address = f"tcp://127.0.0.1:{self.server.getsockname()[1]}"
-        self.conns = []
-        self.data, self.close_after = data, close
-        threading.Thread(target=self.serve, daemon=True).start()
-
-    def serve(self):
-        while True:
-            try:
-                conn, _ = self.server.accept()
-            except OSError:
-                return
-            self.conns.append(conn)
-            try:
-                conn.sendall(self.data)
-                if self.close_after:
-                    conn.close()
-            except OSError:
-                pass
-
-    def stop(self):
-        self.server.close()
-        for conn in self.conns:
-            conn.close()
-
-
 @fuzz("schedulers")
 @given(data=st.binary(max_size=64), close=st.booleans())
 def test_fuzz_schedulers(data, close):
-    listener = ByteListener(data, close)
+    listener = Listener(data, close)
     try:
         started = time.monotonic()
         with pytest.raises(ClusterError) as info:
@@ -266,7 +231,7 @@ def test_fuzz_schedulers(data, close):
         assert time.monotonic() - started < 1.5
         one_line(info.value)
     finally:
-        listener.stop()
+        listener.close()
 
 
 # ---------------------------------------------------------------- output folders under faults
