@@ -269,3 +269,49 @@ def test_a_3d_slip_direction_turns_to_the_closed_form(c, z0):
     assert result.success and result.nit <= 6
     assert np.abs(result.z - exact).max() <= 1e-12
     assert bool(result.stuck[0]) == (np.linalg.norm(c) <= 1.0)
+
+
+class NoContact:
+    """Φ = 0 on all of z: the step problem is the quadratic ½ zᵀSz − cᵀz."""
+
+    def __init__(self, m):
+        self.unknowns = np.arange(m)
+
+    def value(self, z):
+        return 0.0
+
+    def gradient(self, z):
+        return np.zeros_like(z)
+
+    def hessian(self, z, s_floor=0.0, kink_free=False):
+        import scipy.sparse as sp
+        return sp.csr_matrix((z.size, z.size))
+
+
+def test_a_last_newton_step_is_not_lost_in_the_round_off_of_a_far_moved_body():
+    """A body moved far along a soft mode (a cantilever lifted off its
+    glue: |S| |z|² ≫ |E|) from a start a small force off equilibrium. The
+    Newton step lands on z* to round-off, but ½ zᵀSz − cᵀz, a difference
+    of terms of size |S||z|², moves by more than the round-off allowance of
+    the line search (1e-13 |E|) while the true decrease is ~1e-18: judged
+    by totals the step was refused for ever (residual 1.8e-7, 50
+    iterations, on the strip of studies/convergence/adaptive held after it
+    debonded). Judged by the change from the iterate, (Sz − c)·Δ + ½ΔᵀSΔ,
+    it is taken at once."""
+    from adhesive_contact.scheme.condensed import DenseSchur
+
+    m = 80
+    for seed in (0, 2):     # two draws whose totals refused the step (the others
+        rng = np.random.default_rng(seed)   # passed by the luck of the round-off)
+        Q, _ = np.linalg.qr(rng.standard_normal((m, m)))
+        stiffness = np.full(m, 1e3)
+        stiffness[0] = 1e-3                   # the soft mode
+        S = (Q * stiffness) @ Q.T
+        z_star = 100.0 * Q[:, 0] + 1e-2 * rng.standard_normal(m)
+        c = S @ z_star
+        z0 = z_star + 1e-9 * Q[:, 1]          # 1e-6 off in force, stiffness 1e3
+        result = minimise_step(DenseSchur(S), c, NoContact(m), np.full(m, np.inf), z0,
+                               tol=1e-10)
+        assert result.success and result.nit == 1
+        # z* to the conditioning (1e6) times the round-off of |z| = 100
+        assert np.abs(result.z - z_star).max() <= 1e-8

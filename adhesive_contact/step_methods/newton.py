@@ -116,8 +116,21 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
         kink = no_kink()
     tan, kappa = kink.tangential, kink.radius
 
-    def total(z):
-        return 0.5 * z @ (S @ z) - c @ z + energy.value(z)
+    # E at a trial point as E(z) plus its change from the iterate z,
+    # (Sz − c)·Δ + ½ Δ·SΔ + Φ(z + Δ) − Φ(z): ½ zᵀSz − cᵀz itself is a
+    # difference of large terms when the body has moved far (|S||z|² ≫ |E|),
+    # whose round-off would hide the decrease of a last Newton step
+    here = {}
+
+    def anchor(z, E, Sz):
+        here.update(z=z, E=E, g=Sz - c, phi=energy.value(z))
+
+    def total(trial):
+        if not here:
+            return 0.5 * trial @ (S @ trial) - c @ trial + energy.value(trial)
+        step = trial - here["z"]
+        return (here["E"] + here["g"] @ step + 0.5 * step @ (S @ step)
+                + (energy.value(trial) - here["phi"]))
 
     def noise(z, Sz):
         # round-off of E: below it an energy comparison says nothing
@@ -145,6 +158,7 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             if st.residual > CHORD_GAIN * before_chord[2].residual >= tol * st.scale:
                 z, E, st = before_chord
             before_chord = None
+        anchor(z, E, st.Sz)
         g, xi, s, at_zero, unit = st.g, st.xi, st.s, st.at_zero, st.unit
         hn, pg, wall, scale, residual = st.hn, st.pg, st.wall, st.scale, st.residual
         status = (CONVERGED if residual <= tol * scale else
