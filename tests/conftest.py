@@ -312,10 +312,14 @@ def counting(monkeypatch):
 SLS_E_INF, SLS_E_1, SLS_STRAIN = 500.0, 500.0, 1e-3
 
 
-def held_strain_run(steps, T, scheme):
+def held_strain_run(steps, T, scheme, adaptive=None):
     """A 4 × 1 bar of the standard linear solid SLS_* stretched by SLS_STRAIN
-    at t = 0 and held to T in ``steps`` steps of ``time.scheme``: the
-    solution (σ_xx is uniform in every cell)."""
+    at t = 0 and held to T in ``steps`` steps of ``time.scheme`` (with
+    ``adaptive`` as [time.adaptive], k_max = T/steps): the solution (σ_xx
+    is uniform in every cell)."""
+    time = {"T": T, "steps": steps, "scheme": scheme}
+    if adaptive is not None:
+        time["adaptive"] = adaptive
     _, solution = run(scene_dict({
         "mesh.size": [4.0, 1.0], "mesh.cells": [4, 1],
         "boundary": {"dirichlet": [], "displacement": {
@@ -324,7 +328,7 @@ def held_strain_run(steps, T, scheme):
         "material": DELETE,
         "memory": {"kernel": "relaxation", "long_term": {"E": SLS_E_INF, "nu": 0.0},
                    "terms": [{"E": SLS_E_1, "tau": 1.0}]},
-        "time": {"T": T, "steps": steps, "scheme": scheme}}))
+        "time": time}))
     return solution
 
 

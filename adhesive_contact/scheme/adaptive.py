@@ -81,6 +81,17 @@ class StepSizes:
         return j
 
 
+def memory_time(scene):
+    """The time scale τ of the memory's error control: the shortest
+    relaxation time of a Prony or relaxation kernel, T for a general
+    kernel, ∞ without memory (no control)."""
+    memory = getattr(scene, "memory", None)
+    if memory is None:
+        return math.inf
+    terms = getattr(memory, "prony_terms", None) if memory.kernel != "function" else None
+    return min(t.tau for t in terms) if terms else scene.T
+
+
 @dataclass
 class Controller:
     """Accepts or rejects a pair of half steps and picks the next half step.
@@ -98,6 +109,7 @@ class Controller:
     growth: float = 2.0
     shrink: float = 0.25
     safety: float = 0.9
+    memory_time: float = math.inf
     accepted: int = 0
     rejected: int = 0
     forced: int = 0
@@ -107,12 +119,17 @@ class Controller:
         a = scene.adaptive
         return cls(StepSizes.of(scene, stable_step), a.tol, scene.T,
                    2 if scene.scheme == "second-order" else 1, a.rate_floor, a.growth,
-                   a.shrink, a.safety)
+                   a.shrink, a.safety, memory_time(scene))
 
-    def ratio(self, err, j, change=0.0):
-        """q = err / (tol max(Δ, rate_floor 2h_j/T)), Δ = ``change`` of the pair."""
-        return err / (self.tol * max(change, self.rate_floor * 2.0 * self.sizes.size(j)
-                                     / self.T))
+    def ratio(self, err, j, change=0.0, memory=0.0):
+        """q = max(err / (tol max(Δ, rate_floor 2h_j/T)), err_H τ / (tol 2h_j)),
+        Δ = ``change`` of the pair, err_H = ``memory`` the memory's estimate
+        and τ = ``memory_time`` (the kernel's shortest relaxation time)."""
+        h2 = 2.0 * self.sizes.size(j)
+        q = err / (self.tol * max(change, self.rate_floor * h2 / self.T))
+        if memory > 0.0:
+            q = max(q, memory * self.memory_time / (self.tol * h2))
+        return q
 
     def factor(self, q):
         """min(growth, max(shrink, safety q^{−1/p}))."""
@@ -120,12 +137,12 @@ class Controller:
             return self.growth
         return min(self.growth, max(self.shrink, self.safety * q ** (-1.0 / self.order)))
 
-    def judge(self, err, j, at, change=0.0):
+    def judge(self, err, j, at, change=0.0, memory=0.0):
         """(accept, next j) for a pair of half steps h_j starting at unit
         ``at`` with estimated error ``err`` and change Δ = ``change``; the
         next j is that of the pair after it (accepted: from ``at + 2
         span(j)``) or of the retry."""
-        q = self.ratio(err, j, change)
+        q = self.ratio(err, j, change, memory)
         finite = math.isfinite(q)
         accept = (finite and q <= 1.0) or j == self.sizes.halvings
         target = self.sizes.size(j) * (self.factor(q) if finite else self.shrink)
@@ -147,9 +164,11 @@ class Controller:
 @dataclass
 class PairNorm:
     """‖(u, β)‖ = ‖u‖_2 / U + (Σ_f |f| β_f² / |Γ_C|)^½ of the estimate,
-    U the largest ‖u_n‖_2 of the run so far (:meth:`scale` keeps it)."""
+    U the largest ‖u_n‖_2 of the run so far (:meth:`scale` keeps it), and
+    the memory's part of it (:meth:`memory`)."""
 
     measure: np.ndarray   # (nf,) facet measures, or empty
+    shear: float = 1.0    # μ of the elastic tensor C
     largest: float = 0.0
 
     def scale(self, u):
@@ -164,3 +183,16 @@ class PairNorm:
         if self.measure.size:
             eb = math.sqrt(float(self.measure @ (dbeta * dbeta)) / float(self.measure.sum()))
         return (eu + eb) / (2 ** order - 1)
+
+    def memory(self, dhistory, order=1):
+        """The Richardson estimate of the memory's error, ‖Δa_μ‖_2 / (μ U) /
+        (2^p − 1), from the difference ``dhistory`` of a_μ = Σ_m μ_m H^m
+        between the doubled step and the pair (0 for None: no memory). H^m
+        is the rule's history ∫_0^{t_n} e^{−(t_n−s)/τ_m} u(s) ds (the kernel's
+        tensors μ_m, μ that of C): the memory's stress as the displacement
+        whose elastic stress it is. It is not part of the pair's norm: a
+        body held still while its stress relaxes (u fixed) has its error all
+        here."""
+        if dhistory is None or self.largest <= 0:
+            return 0.0
+        return float(np.linalg.norm(dhistory)) / (self.shear * self.largest) / (2 ** order - 1)

@@ -81,8 +81,8 @@ def solve_adaptive(problem, progress=None, raise_on_failure=False, recorder=None
     recorder = recorder or HistoryRecorder(problem)
     measure = (problem.boundary.measure if problem.boundary is not None
                else np.zeros(0))
-    run = _Run(problem, cache, contact, recorder, controller, PairNorm(np.asarray(measure)),
-               progress)
+    norm = PairNorm(np.asarray(measure), scene.material.mu)
+    run = _Run(problem, cache, contact, recorder, controller, norm, progress)
     t_loop = time.perf_counter()
     with one_blas_thread():
         status, failure = run.march(first)
@@ -111,6 +111,18 @@ def solve_adaptive(problem, progress=None, raise_on_failure=False, recorder=None
     return Solution(problem=ran, status=status, message=message, failure=failure, t=t,
                     timings=timings, linear=first.linear, adaptive=run.facts(bound), **notes,
                     **recorder.history())
+
+
+def history(state):
+    """a_μ of the memory's history at the level of ``state`` (the rule's
+    ∫_0^{t_n} R(t_n − s) ε(u(s)) ds: :meth:`decayed` over no step), or
+    None without memory."""
+    fields = state.memory.fields(state.memory.decayed(0.0))
+    return None if fields is None else fields[1]
+
+
+def difference(a, b):
+    return None if a is None or b is None else a - b
 
 
 class _Run:
@@ -171,11 +183,13 @@ class _Run:
                 continue
             self.norm.scale(one[0].u)
             self.norm.scale(two[0].u)
+            order = self.controller.order
             err = (math.inf if big is None else
-                   self.norm(two[0].u - big[0].u, two[0].beta - big[0].beta,
-                             self.controller.order))
+                   self.norm(two[0].u - big[0].u, two[0].beta - big[0].beta, order))
+            memory = (0.0 if big is None else
+                      self.norm.memory(difference(history(two[0]), history(big[0])), order))
             change = self.norm(two[0].u - state.u, two[0].beta - state.beta)
-            accept, j_next = self.controller.judge(err, j, at, change)
+            accept, j_next = self.controller.judge(err, j, at, change, memory)
             if not accept:
                 self.restore(notes)
                 j = j_next

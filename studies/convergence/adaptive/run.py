@@ -1,6 +1,7 @@
 """Adaptive time steps against uniform ones on the debonding strip.
 
     python studies/convergence/adaptive/run.py [--tols 0.1 ... 0.001] [--steps 32 ... 2048]
+                                               [--reference 16384] [--held]
 
 The scene is (h) of studies/convergence (``../h_debonding_strip.toml``: a
 glued strip with memory, slip weakening and Frémond bonding, peeled and
@@ -47,9 +48,20 @@ STEPS = (32, 64, 128, 256, 512, 1024, 2048)
 REFERENCE = 16384
 
 
+#: ``--held``: the same strip to T = 2 with its load held from t = 0.8 on, so
+#: that it debonds in a burst under the held load (β mean 0.95 at t = 0.8,
+#: 0.10 at 1.34, 1e-4 at 1.9) and then creeps with the glue gone: a burst
+#: followed by relaxation (k_max = T/32 again, within the explicit bound)
+HELD = {"T": 2.0, "right": ["7*minimum(t, 0.8)", "14*minimum(t, 0.8)"]}
+held = False
+
+
 def scene(steps=32, tol=None, scheme="paper"):
     data = tomllib.loads(SCENE.read_text())
     data = copy.deepcopy(data)
+    if held:
+        data["time"]["T"] = HELD["T"]
+        data["loads"]["traction"]["right"] = list(HELD["right"])
     data["time"]["steps"] = steps
     if scheme != "paper":
         data["time"]["scheme"] = scheme
@@ -147,7 +159,12 @@ def main():
     parser.add_argument("--tols", type=float, nargs="+", default=TOLS)
     parser.add_argument("--steps", type=int, nargs="+", default=STEPS)
     parser.add_argument("--reference", type=int, default=REFERENCE)
+    parser.add_argument("--held", action="store_true",
+                        help="the load held from t = 0.8 to T = 2 (results/held/)")
     args = parser.parse_args()
+    global RESULTS, held
+    if args.held:
+        held, RESULTS = True, RESULTS / "held"
     ref = reference(args.reference)
     problem = build_problem(scene())
     M = mass_matrix(problem.mesh)
@@ -199,7 +216,8 @@ def plot(uniform, adaptive):
         ax.set_xlabel(label)
         ax.set_ylabel("E (u rel. L² + β rms, max over levels)")
         ax.legend(fontsize=8)
-    fig.suptitle("(h) debonding strip: adaptive against uniform steps")
+    fig.suptitle("(h) debonding strip" + (", load held from t = 0.8 to T = 2" if held else "")
+                 + ": adaptive against uniform steps")
     fig.tight_layout()
     fig.savefig(RESULTS / "adaptive.png", dpi=120)
 
