@@ -37,11 +37,17 @@ def test_a_step_with_two_solutions_is_named_and_another_run_finds_the_other():
     reaches another solution. A separate one-step run to t = 0.85 (no
     memory, so its step is the same minimisation, started at rest) ends
     at a contact displacement that differs from the run's by what the
-    warning says."""
+    warning says. Step 12 (t = 0.6), where the slip front snaps on (17
+    Newton iterations), has two solutions as well: the run started with the
+    stick front moved on (ContactStep.front_moved_on) reaches one whose
+    frame displacement is 2 % off the one the start without it reached,
+    meets an indefinite Newton matrix on the way, and its second start from
+    rest ends 5 % off in the contact unknowns; from step 13 on the runs
+    with and without the front moved on agree to round-off."""
     sol = solve(build_problem(weakening(1.0, 20)))
-    assert sol.success and sorted(sol.two_solution_steps) == [17]
+    assert sol.success and sorted(sol.two_solution_steps) == [12, 17]
     (line,) = [w for w in solution_warnings(sol) if "more than one solution" in w]
-    assert line.startswith("step 17 (t = 0.85) has more than one solution")
+    assert line.startswith("steps 12, 17 (t = 0.6, 0.85) have more than one solution")
     one = solve(build_problem(weakening(0.85, 1)))
     assert one.success
     a, b = sol.frame_displacement[17], one.frame_displacement[-1]
