@@ -204,10 +204,11 @@ def solve_command(scene, out, force, quiet):
                 # a partial run never replaces a complete earlier one
                 kept = not solution.success and holds_complete_run(out)
                 if solution.t.size and not kept:   # the levels that converged
-                    for warning in solution_warnings(solution):
+                    lines = solution_warnings(solution)   # once: they read every level
+                    for warning in lines:
                         if not quiet:
                             click.echo(f"warning: {warning}", err=True)
-                    files = write_results(solution, folder, failures, source)
+                    files = write_results(solution, folder, failures, source, lines)
             finally:
                 recorder.close()
             files = sorted(files + recorder.names) if files else []

@@ -39,14 +39,18 @@ from .summary import energy_record, smallness_record, step_records
 SCHEMA = 1
 
 
-def summary(solution, source=None, history=None):
+def summary(solution, source=None, history=None, lines=None):
     """The ``summary.json`` document (a dict of plain JSON types).
 
     ``source``: ``{"text", "folder"}``, the scene's TOML text and the
     absolute folder its relative paths are taken in (None: the working
     directory), from which :func:`adhesive_contact.io.load_solution`
-    rebuilds the problem."""
+    rebuilds the problem. ``lines``: the run's
+    :func:`~adhesive_contact.problem.warnings.solution_warnings`, when the
+    caller has them already (they read every level's gradients)."""
     problem = solution.problem
+    if lines is None:
+        lines = solution_warnings(solution)
     mesh, boundary = problem.mesh, problem.boundary
     return {
         "schema": SCHEMA,
@@ -62,7 +66,7 @@ def summary(solution, source=None, history=None):
         },
         "run": run_record(solution),
         "smallness": smallness_record(problem),
-        "warnings": [str(w) for w in problem.warnings()] + solution_warnings(solution),
+        "warnings": [str(w) for w in problem.warnings()] + list(lines),
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
         **({"adaptive": {key: json_number(v) if isinstance(v, float) else v
@@ -108,9 +112,9 @@ def run_record(solution):
     }
 
 
-def write_summary(solution, path, source=None, history=None):
+def write_summary(solution, path, source=None, history=None, lines=None):
     """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
-    write_json(path, summary(solution, source, history))
+    write_json(path, summary(solution, source, history, lines))
 
 
 #: every file name ``adhcontact solve`` may write; in an existing folder a
@@ -151,15 +155,16 @@ def staged_output(out):
         yield tmp
 
 
-def write_results(solution, folder, failures=None, source=None):
+def write_results(solution, folder, failures=None, source=None, lines=None):
     """Write summary.json, solution.npz and the plots of a solution into
     ``folder`` (the XDMF series are the recorder's); return their names. A
     plot that cannot be drawn is left out and named in ``failures`` (a
     list), if given; the data files are written all the same. ``source``:
-    the scene's text and folder (:func:`summary`)."""
+    the scene's text and folder, ``lines`` the run's warnings if known
+    (:func:`summary`)."""
     folder = Path(folder)
     history = energies(solution)   # once, for summary.json and the figures
-    write_summary(solution, folder / "summary.json", source, history)
+    write_summary(solution, folder / "summary.json", source, history, lines)
     write_npz(solution, folder / "solution.npz")
     return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures, history)
 

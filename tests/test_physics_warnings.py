@@ -22,7 +22,8 @@ from adhesive_contact.problem.plausibility import (
     prony_note,
     unit_warnings,
 )
-from adhesive_contact.problem.warnings import geometry_warning, solution_warnings
+from adhesive_contact.problem.warnings import (geometry_warning, solution_warnings,
+                                               symmetric_extremes)
 from adhesive_contact_cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -161,3 +162,24 @@ def test_check_shows_the_unit_warning(tmp_path):
                                         "output": {"units": {"stress": "MPa"}}})))
     result = CliRunner().invoke(main, ["check", str(path)])
     assert "warning: material.E = 1e+09 MPa is 1e+15 Pa" in result.stdout
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_closed_form_eigenvalues_are_lapacks(d):
+    """The extreme eigenvalues of the small-strain check, in closed form,
+    against numpy's eigvalsh: random symmetric matrices, multiples of I
+    (p = 0), a double eigenvalue, and rank one (½ GᵀG of a single shear)."""
+    rng = np.random.default_rng(7)
+    A = rng.standard_normal((2000, d, d))
+    A = A + A.transpose(0, 2, 1)
+    A[0] = 3.0 * np.eye(d)
+    A[1] = np.diag([2.0] * (d - 1) + [-1.0])
+    g = np.zeros((d, d))
+    g[0, 1] = 0.4
+    A[2] = 0.5 * g.T @ g
+    low, high = symmetric_extremes(A)
+    w = np.linalg.eigvalsh(A)
+    scale = np.abs(w).max(axis=1)
+    # the cubic's trigonometric solution loses a few digits near a double root
+    assert np.all(np.abs(low - w[:, 0]) <= 1e-12 * scale)
+    assert np.all(np.abs(high - w[:, -1]) <= 1e-12 * scale)
