@@ -22,7 +22,7 @@ from adhesive_contact.scheme.adaptive_memory import FunctionMemory, PronyMemory,
 
 def controller(halvings=6, steps=4, T=1.0, tol=1e-3, stable=math.inf, order=1):
     # rate_floor 1 and no change given: q = err T / (tol 2h), the error per unit time
-    scene = SimpleNamespace(T=T, steps=steps, k=T / steps, scheme="paper",
+    scene = SimpleNamespace(T=T, steps=steps, k=T / steps, scheme="paper", memory=None,
                             adaptive=SimpleNamespace(tol=tol, halvings=halvings, growth=2.0,
                                                      shrink=0.25, safety=0.9, rate_floor=1.0))
     c = Controller.of(scene, stable)

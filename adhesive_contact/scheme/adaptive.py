@@ -36,6 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..problem.accuracy import shortest_relaxation_time
+
 
 @dataclass
 class StepSizes:
@@ -85,11 +87,10 @@ def memory_time(scene):
     """The time scale τ of the memory's error control: the shortest
     relaxation time of a Prony or relaxation kernel, T for a general
     kernel, ∞ without memory (no control)."""
-    memory = getattr(scene, "memory", None)
-    if memory is None:
+    if scene.memory is None:
         return math.inf
-    terms = getattr(memory, "prony_terms", None) if memory.kernel != "function" else None
-    return min(t.tau for t in terms) if terms else scene.T
+    tau = shortest_relaxation_time(scene)
+    return scene.T if tau is None else tau
 
 
 @dataclass

@@ -236,19 +236,18 @@ class ContactStep:
         if kink is None or kink.held:
             return z
         rough = kink.radius > 0
-        stuck_last = ~np.any(kink.xi(last) != 0, axis=1) & rough
+        xi_last = kink.xi(last)
+        stuck_last = ~np.any(xi_last != 0, axis=1) & rough
         left = ~np.any(kink.xi(before) != 0, axis=1) & ~stuck_last & rough
         m = int(left.sum())
         if m == 0:
             return z
         st = stationarity(S, c, self.energy, upper, z, kink)
-        candidates = st.at_zero & rough & (st.hn > FRONT_NEAR * kink.radius)
-        if not candidates.any():
+        near = np.flatnonzero(st.at_zero & rough & (st.hn > FRONT_NEAR * kink.radius))
+        if near.size == 0:
             return z
-        ratio = np.where(candidates, st.hn / np.where(rough, kink.radius, 1.0), -np.inf)
-        chosen = np.argsort(-ratio)[:m]
-        chosen = chosen[candidates[chosen]]
-        slip = float(np.median(np.linalg.norm(kink.xi(last)[left], axis=1)))
+        chosen = near[np.argsort(-st.hn[near] / kink.radius[near])[:m]]
+        slip = float(np.median(np.linalg.norm(xi_last[left], axis=1)))
         rows = np.zeros(kink.radius.size, dtype=bool)
         rows[chosen] = True
         moved = np.zeros(kink.tangential.shape)
