@@ -137,8 +137,7 @@ def steps_for_memory(scene, scheme=None, guide=MEMORY_GUIDE):
 
 def shortest_relaxation_time(scene):
     """min τ_m of a Prony or relaxation kernel, None otherwise."""
-    terms = scene.memory.prony_terms if scene.memory is not None else ()
-    return min(t.tau for t in terms) if terms else None
+    return None if scene.memory is None else scene.memory.shortest_relaxation_time
 
 
 def bonding_time_scale(problem):

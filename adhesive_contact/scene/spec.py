@@ -90,6 +90,12 @@ class MemorySpec:
                          for t in self.terms)
         return ()
 
+    @property
+    def shortest_relaxation_time(self):
+        """min τ_m of a Prony or relaxation kernel, None for ``function``."""
+        terms = self.prony_terms
+        return min(t.tau for t in terms) if terms else None
+
 
 @dataclass(frozen=True)
 class LawSpec:

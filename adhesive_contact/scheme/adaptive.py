@@ -36,8 +36,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..problem.accuracy import shortest_relaxation_time
-
 
 @dataclass
 class StepSizes:
@@ -89,7 +87,7 @@ def memory_time(scene):
     kernel, ∞ without memory (no control)."""
     if scene.memory is None:
         return math.inf
-    tau = shortest_relaxation_time(scene)
+    tau = scene.memory.shortest_relaxation_time
     return scene.T if tau is None else tau
 
 
