@@ -118,6 +118,28 @@ def test_refinement_that_stops_early_factorises_in_double_precision():
     assert np.linalg.norm(x - ref) <= 1e-10 * np.linalg.norm(ref)
 
 
+def test_refinement_stops_at_the_accuracy_asked_for():
+    """With accuracy = (rtol, atol) the refinement stops once
+    ‖b − Hx‖ ≤ rtol ‖b‖ (an inexact Newton step), in fewer products than
+    refining to round-off; without it, to round-off."""
+    H, b = spd(1e5)
+    products = []
+
+    def counted(v):
+        products.append(1)
+        return H @ v
+
+    args = single(H)
+    loose = mixed_precision_solver(args[0].copy(), counted, *args[2:])
+    x = loose(b, (1e-2, 0.0))
+    rough = len(products)
+    assert np.linalg.norm(b - H @ x) <= 1e-2 * np.linalg.norm(b)
+    products.clear()
+    y = loose(b)
+    assert len(products) > rough
+    assert np.linalg.norm(b - H @ y) <= 1e-13 * 1e5 * np.linalg.norm(y) * 10
+
+
 @pytest.mark.parametrize("fraction", [1.0, 0.6])
 def test_newton_systems_in_single_precision_equal_the_double_ones(monkeypatch, fraction):
     """DenseSchur.newton_solve from MIXED_FROM free coordinates on: S_FF

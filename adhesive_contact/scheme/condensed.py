@@ -63,13 +63,14 @@ def dense_solver(H, mixed_from=MIXED_FROM):
         # Fortran order, which LAPACK takes without the transposing copy
         # f2py makes of a C-ordered array (a 6000² Cholesky: 0.72 → 0.42 s)
         factor = la.cho_factor(H.T, check_finite=False)
-        return flagged(lambda rhs: la.cho_solve(factor, rhs, check_finite=False), False)
+        return flagged(lambda rhs, accuracy=None: la.cho_solve(factor, rhs, check_finite=False),
+                       False)
     except la.LinAlgError:
         vals, vecs = la.eigh(H)
         largest = max(np.abs(vals).max(initial=0.0), 1e-300)
         indefinite = bool(vals.min(initial=0.0) < -INDEFINITE * largest)
         vals = np.maximum(np.abs(vals), 1e-8 * largest)
-        return flagged(lambda rhs: vecs @ ((vecs.T @ rhs) / vals), indefinite)
+        return flagged(lambda rhs, accuracy=None: vecs @ ((vecs.T @ rhs) / vals), indefinite)
 
 
 #: an eigenvalue below −INDEFINITE·(the largest) makes a Newton matrix
@@ -100,7 +101,11 @@ def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
 
     Returns None where single precision does not factorise H (H not
     positive definite, or too ill-conditioned); the solver factorises H in
-    double precision if CG does not reach rtol in ``maxiter`` products."""
+    double precision if CG does not reach rtol in ``maxiter`` products.
+    Its ``accuracy = (rtol, atol)``, when given, lets CG stop as soon as
+    ‖b − H x‖₂ ≤ max(rtol ‖b‖₂, atol) (an inexact Newton step: the
+    single-precision solve alone, after one product, where that is as
+    good as the forcing term asks)."""
     m = H32.shape[0]
     threads = all_blas_threads() if m >= THREADED_FROM else nullcontext()
     try:
@@ -114,10 +119,13 @@ def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
     operator = LinearOperator((m, m), dtype=float, matvec=apply)
     scale = rtol * largest
 
-    def solve(rhs):
+    def solve(rhs, accuracy=None):
         start = precondition @ rhs
-        x, info = cg(operator, rhs, x0=start, M=precondition, rtol=0.0,
-                     atol=scale * np.linalg.norm(start), maxiter=maxiter)
+        bound = scale * np.linalg.norm(start)
+        if accuracy is not None:
+            bound = max(bound, accuracy[0] * np.linalg.norm(rhs), accuracy[1])
+        x, info = cg(operator, rhs, x0=start, M=precondition, rtol=0.0, atol=bound,
+                     maxiter=maxiter)
         if info == 0:
             return x
         return dense_solver(exact(), mixed_from=np.inf)(rhs)
@@ -171,8 +179,13 @@ class DenseSchur(RememberedProduct):
     def newton_solve(self, H_phi, rhs, free, accuracy=None):
         """Solve (S + H_φ)_FF d = rhs on the free coordinates F (a boolean
         mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`, to
-        round-off (an ``accuracy`` an iterative solve may stop at is not
-        needed).
+        round-off below MIXED_FROM free coordinates; from there on, its
+        single-precision factor refined to ``accuracy = (rtol, atol)``
+        (the step method's forcing term; to round-off without it).
+        Measured on the 2D strip of studies/bench/ladder.py at 1e6 dofs
+        (4000 contact unknowns), where a refinement iteration (a product
+        with S and a single-precision solve, 19 ms) costs a third of a
+        factorisation (67 ms): see studies/README.md.
         Only the entries of H_φ are added to the copy of S_FF; from
         MIXED_FROM free coordinates on, that copy is taken in single
         precision and the products of the refinement use S itself."""
@@ -204,7 +217,7 @@ class DenseSchur(RememberedProduct):
             if solve is not None:
                 self.indefinite = False
                 self.kept = (free.copy(), solve)
-                return solve(rhs), True
+                return solve(rhs, accuracy), True
         solve = dense_solver(exact(), mixed_from=np.inf)
         self.indefinite = solve.indefinite
         self.indefinite_solves += solve.indefinite
@@ -216,13 +229,13 @@ class DenseSchur(RememberedProduct):
         """Solve the matrix (S + H_φ)_FF of the last :meth:`newton_solve`
         again, its factorisation reused, for a new right-hand side (the
         chord step of :mod:`adhesive_contact.step_methods.newton`; to
-        round-off, ``accuracy`` is not needed): d, or None when
+        ``accuracy`` as in :meth:`newton_solve`): d, or None when
         ``system`` (:attr:`kept` when the caller solved it) is no longer
         the kept one, ``free`` is not its F, or that matrix was
         indefinite."""
         if self.kept is None or system is not self.kept or not np.array_equal(self.kept[0], free):
             return None
-        return self.kept[1](rhs)
+        return self.kept[1](rhs, accuracy)
 
     def release(self):
         """Let the factor kept for :meth:`chord_solve` go."""
