@@ -135,11 +135,15 @@ def mixed_precision_solver(H32, apply, largest, exact, rtol=1e-14, maxiter=30):
 class RememberedProduct:
     """``M @ z`` by ``self.matrix``, the last product with a vector kept:
     the step methods ask for M z of the iterate a line search has just
-    tried (an O(m) comparison against a product)."""
+    tried (an O(m) comparison against a product); and M 0 = 0 without
+    one (the moves of the held coordinates, zero once the sets hold: a
+    fifth of the products of a step solve on the 2D strip)."""
 
     _last = (None, None)   # (z, M z) of the last product
 
     def __matmul__(self, z):
+        if np.ndim(z) == 1 and not np.any(z):
+            return np.zeros(self.matrix.shape[0])
         last, product = self._last
         if last is not None and last.shape == np.shape(z) and np.array_equal(last, z):
             return product.copy()
