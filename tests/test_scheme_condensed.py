@@ -129,8 +129,8 @@ def test_refinement_stops_at_the_accuracy_asked_for():
         products.append(1)
         return H @ v
 
-    args = single(H)
-    loose = mixed_precision_solver(args[0].copy(), counted, *args[2:])
+    H32, _, largest, exact = single(H)
+    loose = mixed_precision_solver(H32, counted, largest, exact)
     x = loose(b, (1e-2, 0.0))
     rough = len(products)
     assert np.linalg.norm(b - H @ x) <= 1e-2 * np.linalg.norm(b)

@@ -182,17 +182,14 @@ class DenseSchur(RememberedProduct):
 
     def newton_solve(self, H_phi, rhs, free, accuracy=None):
         """Solve (S + H_φ)_FF d = rhs on the free coordinates F (a boolean
-        mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`, to
-        round-off below MIXED_FROM free coordinates; from there on, its
-        single-precision factor refined to ``accuracy = (rtol, atol)``
-        (the step method's forcing term; to round-off without it).
-        Measured on the 2D strip of studies/bench/ladder.py at 1e6 dofs
-        (4000 contact unknowns), where a refinement iteration (a product
-        with S and a single-precision solve, 19 ms) costs a third of a
-        factorisation (67 ms): see studies/README.md.
-        Only the entries of H_φ are added to the copy of S_FF; from
-        MIXED_FROM free coordinates on, that copy is taken in single
-        precision and the products of the refinement use S itself."""
+        mask; H_φ sparse): ``(d, converged)``, by :func:`dense_solver`.
+        Only the entries of H_φ are added to the copy of S_FF. Below
+        MIXED_FROM free coordinates the copy is double precision and d
+        exact to round-off; from there on it is taken in single precision
+        and refined, by products with S itself, to ``accuracy = (rtol,
+        atol)`` (the step method's forcing term; to round-off without it:
+        a refinement iteration costs a third of a factorisation at 4000
+        unknowns, studies/README.md)."""
         self.release()   # the last factor goes before the next is made
         idx = np.flatnonzero(free)
         everything = idx.size == free.size
