@@ -7,8 +7,8 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from conftest import (assert_one_line_error, glued_contact, invoke, prony, scene_dict,
-                      solve_scene)
+from conftest import (DELETE, SLS_E_1, SLS_E_INF, assert_one_line_error, glued_contact,
+                      invoke, prony, scene_dict, solve_scene)
 
 from adhesive_contact import scene_from_dict
 from adhesive_contact.problem.build import build_problem
@@ -32,8 +32,9 @@ def controller(halvings=6, steps=4, T=1.0, tol=1e-3, stable=math.inf, order=1):
 
 def drive(c, error):
     """Run the controller over [0, T] with err(t, h) = ``error``; returns the
-    accepted half steps with their start units and the number of trials."""
-    sizes, at, j = c.sizes, 0, c.sizes.halvings
+    accepted half steps with their start units and the number of trials
+    (from the largest step, as the loop starts)."""
+    sizes, at, j = c.sizes, 0, c.sizes.first
     accepted, trials = [], 0
     while at < sizes.units:
         trials += 1
@@ -72,6 +73,8 @@ def test_controller_rejects_grows_and_keeps_to_the_quantised_set():
     # every accepted pair meets the tolerance (none at k_min was forced)
     assert c.forced == 0
     assert c.accepted == len(accepted)
+    # every pair starts on its own grid: at a multiple of 2h
+    assert all(at % (2 * sizes.span(j)) == 0 for at, j in accepted)
 
 
 def test_controller_forces_k_min_and_caps_at_the_explicit_bound():
@@ -111,6 +114,34 @@ def test_the_last_pair_lands_on_T():
     sizes = StepSizes(k_max=0.25, halvings=3, units=4 * 8)
     assert sizes.index(1.0, sizes.units - 2) == 3        # one k_min pair left
     assert sizes.index(1.0, sizes.units - 8) == 1        # 2 h = 8 units
+
+
+def test_a_pair_starts_on_its_own_grid():
+    """A step grows only where the larger pair starts (a multiple of its
+    2h), so the run reaches T with the step it has: from unit 2, 4, 8, 16 of
+    32 (k_min = 1/32, k_max = 1/4) the largest pair allowed is 2, 4, 8, 16
+    units long."""
+    sizes = StepSizes(k_max=0.25, halvings=3, units=4 * 8)
+    assert [sizes.index(1.0, at) for at in (2, 4, 8, 16, 6, 12)] == [3, 2, 1, 0, 3, 2]
+    assert sizes.index(0.1, 16) == 2                     # the target still caps it
+
+
+def test_the_doubled_step_keeps_a_relaxation_step_tensor_definite():
+    """With a relaxation kernel the doubled step 2h is an adaptive run's
+    largest: C_∞ + (1 − 2h/τ) C_1 must stay positive definite. The standard
+    linear solid E_∞ = E_1, τ = 1 (k_max = 1: 2h = 2 gives E_∞ − E_1 = 0)
+    starts one halving down, 2h = 1."""
+    data = scene_dict({
+        "mesh.size": [4.0, 1.0], "mesh.cells": [4, 1],
+        "material": DELETE,
+        "memory": {"kernel": "relaxation", "long_term": {"E": SLS_E_INF, "nu": 0.0},
+                   "terms": [{"E": SLS_E_1, "tau": 1.0}]},
+        "time": {"T": 8.0, "steps": 8, "adaptive": {"tol": 0.01}}})
+    assert SLS_E_INF == SLS_E_1
+    sizes = StepSizes.of(scene_from_dict(data))
+    assert sizes.first == 1 and 2 * sizes.size(sizes.first) == 1.0
+    data["memory"]["long_term"]["E"] = 2 * SLS_E_1          # E_∞ − E_1 > 0 at 2h = 2
+    assert StepSizes.of(scene_from_dict(data)).first == 0
 
 
 def test_pair_norm_is_the_richardson_estimate():

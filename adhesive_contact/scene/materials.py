@@ -92,13 +92,19 @@ def instantaneous(memory):
     return Isotropic(lam, mu)
 
 
-def check_relaxation_step(memory, dim, k):
-    """The step tensor G(0) + k R(0) = C_∞ + Σ_i (1 − k/τ_i) C_i must be
-    positive definite (else the step matrix is indefinite)."""
+def relaxation_step_definite(memory, dim, k):
+    """Whether the step tensor G(0) + k R(0) = C_∞ + Σ_i (1 − k/τ_i) C_i of
+    a relaxation kernel is positive definite (μ > 0, λ + 2μ/d > 0)."""
     parts = [(memory.long_term, 1.0)] + [(t.tensor, 1.0 - k / t.tau) for t in memory.terms]
     lam = sum(p.lam * w for p, w in parts)
     mu = sum(p.mu * w for p, w in parts)
-    if not (mu > 0 and lam + 2.0 * mu / dim > 0):
+    return mu > 0 and lam + 2.0 * mu / dim > 0
+
+
+def check_relaxation_step(memory, dim, k):
+    """The step tensor G(0) + k R(0) = C_∞ + Σ_i (1 − k/τ_i) C_i must be
+    positive definite (else the step matrix is indefinite)."""
+    if not relaxation_step_definite(memory, dim, k):
         tau = min(t.tau for t in memory.terms)
         raise SceneError("time.steps", f"the time step k = {k:g} is too large for the "
                          f"relaxation time tau = {tau:g}: the step tensor C_inf + "

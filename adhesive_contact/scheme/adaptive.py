@@ -36,6 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..scene.materials import relaxation_step_definite
+
 
 @dataclass
 class StepSizes:
@@ -51,11 +53,20 @@ class StepSizes:
     @classmethod
     def of(cls, scene, stable_step=math.inf):
         """The step sizes of an adaptive ``scene`` with the explicit Euler
-        bound ``stable_step`` on every step (the doubled one included)."""
+        bound ``stable_step`` on every step (the doubled one included); with
+        a relaxation kernel the doubled step 2h also keeps the step tensor
+        C_∞ + Σ_i (1 − 2h/τ_i) C_i positive definite (the scene's check
+        holds k_max to it)."""
         adaptive = scene.adaptive
         k_max = scene.k
+        memory = scene.memory if (scene.memory is not None
+                                  and scene.memory.kernel == "relaxation") else None
+
+        def allowed(k):
+            return k <= stable_step and (
+                memory is None or relaxation_step_definite(memory, scene.dim, k))
         first = 0
-        while first < adaptive.halvings and 2.0 * k_max * 2.0 ** -first > stable_step:
+        while first < adaptive.halvings and not allowed(2.0 * k_max * 2.0 ** -first):
             first += 1
         return cls(k_max, adaptive.halvings, scene.steps * 2 ** adaptive.halvings, first)
 
@@ -68,15 +79,22 @@ class StepSizes:
         return 2 ** (self.halvings - j)
 
     def index(self, target, at):
-        """The j of the largest quantised half step ≤ ``target`` whose doubled
-        step 2h_j fits in what is left after unit ``at``, within
-        [first, halvings]."""
+        """The j of the largest quantised half step ≤ ``target`` whose pair
+        starts on its own grid (``at`` a multiple of 2h_j in units) and fits
+        in what is left after unit ``at``, within [first, halvings].
+
+        Aligned so, a pair never straddles the boundary of a larger one: a
+        step grows once the run reaches a multiple of the larger pair, and
+        the run lands on T (``units``, a multiple of every 2h_j below k_max)
+        with the step it has instead of halving down to k_min to fill what
+        is left."""
         if target >= self.k_max:
             j = self.first
         else:
             j = max(self.first, int(math.ceil(math.log2(self.k_max / target) - 1e-12)))
         j = min(j, self.halvings)
-        while j < self.halvings and 2 * self.span(j) > self.units - at:
+        while j < self.halvings and (2 * self.span(j) > self.units - at
+                                     or at % (2 * self.span(j))):
             j += 1
         return j
 

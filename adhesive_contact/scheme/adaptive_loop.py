@@ -76,7 +76,7 @@ def solve_adaptive(problem, progress=None, raise_on_failure=False, recorder=None
     controller = Controller.of(scene, bound)
     sizes = controller.sizes
     cache = OperatorCache(problem, instantaneous_only(scene.memory, trapezoid), sizes)
-    first = cache.get(sizes.halvings, initial=True)   # level 0 and the first pair: k_min
+    first = cache.get(sizes.first, initial=True)   # level 0 and the first pair: k_max
     contact = (ContactStep(problem, first.within) if problem.boundary is not None else None)
     recorder = recorder or HistoryRecorder(problem)
     measure = (problem.boundary.measure if problem.boundary is not None
@@ -162,7 +162,7 @@ class _Run:
         self.keep(level, 0)
         if self.stop():
             return (SUCCESS if sizes.units == 0 else STOPPED), None
-        at, j = 0, sizes.halvings
+        at, j = 0, sizes.first   # the largest step; a rejection shrinks it
         while at < sizes.units:
             notes = self.notes()
             big, failure = self.trial(state, at, j - 1)
