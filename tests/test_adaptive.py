@@ -21,7 +21,7 @@ from adhesive_contact.scheme.adaptive_memory import FunctionMemory, PronyMemory,
 
 
 def controller(halvings=6, steps=4, T=1.0, tol=1e-3, stable=math.inf, order=1):
-    # rate_floor 1 and no change given: q = err T / (tol 2h), the error per unit time
+    # rate_floor 1 and no change given: q = 64 err / tol, the error per pair
     scene = SimpleNamespace(T=T, steps=steps, k=T / steps, scheme="paper", memory=None,
                             adaptive=SimpleNamespace(tol=tol, halvings=halvings, growth=2.0,
                                                      shrink=0.25, safety=0.9, rate_floor=1.0))
@@ -50,8 +50,8 @@ def drive(c, error):
 
 def test_controller_rejects_grows_and_keeps_to_the_quantised_set():
     c = controller(halvings=8, tol=0.01)
-    # a smooth error C h^2 (q = h/(4 tol): h <= 0.04 passes), 20 times larger
-    # in a burst around t = 0.6 (h <= 0.002 there)
+    # a smooth error C h^2 (q = 64 err/tol = 3200 h^2: h <= 0.0177 passes), 20
+    # times larger in a burst around t = 0.6 (h <= 0.00395 there)
     def error(t, h):
         return (1.0 + 19.0 * (abs(t - 0.6) < 0.05)) * 0.5 * h * h
     accepted, end = drive(c, error)
@@ -68,8 +68,8 @@ def test_controller_rejects_grows_and_keeps_to_the_quantised_set():
     assert min(np.diff(js), default=0) <= -1
     starts = np.array([at for at, _ in accepted]) * sizes.size(sizes.halvings)
     inside = np.abs(starts - 0.6) < 0.05
-    assert h[inside].max() <= 0.002                # small steps in the burst,
-    assert h[~inside].max() == sizes.size(3)       # the largest that passes outside
+    assert h[inside].max() <= 0.00395              # small steps in the burst,
+    assert h[~inside].max() == sizes.size(4)       # the largest that passes outside
     # every accepted pair meets the tolerance (none at k_min was forced)
     assert c.forced == 0
     assert c.accepted == len(accepted)
@@ -87,11 +87,20 @@ def test_controller_forces_k_min_and_caps_at_the_explicit_bound():
     assert min(j for _, j in accepted) == 3
 
 
-def test_the_tolerance_is_relative_to_the_change_of_the_pair():
+def test_the_tolerance_is_on_the_lag_of_the_pair():
+    """q = ℓ/(tol T/64), ℓ = 2h err/Δ the pair's time lag (Δ floored at
+    rate_floor 2h/T); at 2h = T/64 that is the relative change err/(tol Δ)."""
     c = controller(tol=0.01)
     j = 4   # 2h = 1/32
-    assert c.ratio(1e-3, j, change=0.5) == pytest.approx(1e-3 / (0.01 * 0.5))
-    assert c.ratio(1e-3, j, change=0.0) == pytest.approx(1e-3 / (0.01 * 1.0 / 32))
+    lag = (1.0 / 32) * 1e-3 / 0.5
+    assert c.ratio(1e-3, j, change=0.5) == pytest.approx(lag / (0.01 / 64), rel=1e-14)
+    assert c.ratio(1e-3, j, change=0.0) == pytest.approx(64 * 1e-3 / 0.01, rel=1e-14)
+    assert c.ratio(1e-3, 5, change=0.5) == pytest.approx(1e-3 / (0.01 * 0.5), rel=1e-14)
+    # the next step from q ∝ h^{p+1}: safety q^{-1/(p+1)}, within [shrink, growth]
+    assert c.factor(0.9 ** 2 / 1.5 ** 2) == pytest.approx(1.5)   # p = 1
+    assert c.factor(1e6) == 0.25 and c.factor(1e-6) == 2.0
+    # the memory's q_H ∝ h^p decides when it is the tighter: safety q_H^{-1/p}
+    assert c.factor(1e-6, 0.9 / 1.2) == pytest.approx(1.2)
 
 
 def test_the_memory_error_is_per_unit_time_of_its_relaxation():

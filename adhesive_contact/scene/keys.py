@@ -219,8 +219,8 @@ _DECLARATIONS = (
     Key("time.adaptive", "table", None, "adaptive time steps by step doubling, k_max = T/N "
         "(uniform steps k = T/N when absent)"),
     # below 1e-8 the steps reach k_min everywhere; above 1 nothing is controlled
-    Key("time.adaptive.tol", "number", REQUIRED, "the local error of a pair of steps "
-        "allowed, relative to what the pair changes (u relative plus β rms)",
+    Key("time.adaptive.tol", "number", REQUIRED, "the time lag a pair of steps may make "
+        "(its local error over its rate of change, u relative plus β rms), in units of T/64",
         bounds=Interval(1e-8, 1.0)),
     Key("time.adaptive.rate_floor", "number", 1e-3, "the smallest change per unit time "
         "the tolerance is relative to (a quiet stretch counts as changing at this rate)",

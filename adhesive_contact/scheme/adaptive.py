@@ -13,22 +13,29 @@ from the one step 2h over the same interval (Richardson, scheme of order p),
     err = ‖y_{2×h} − y_{2h}‖ / (2^p − 1),   ‖y‖ = ‖u‖_2 / U + ‖β‖_{rms}
 
 with U the largest ‖u_n‖_2 so far (a relative displacement) and the rms of
-β weighted by the facet measures. The tolerance is relative to what the
-pair changes, Δ = ‖y_{t+2h} − y_t‖ in the same norm, floored at
-``rate_floor`` 2h/T (a quiet stretch counts as changing at that rate): the
-pair is accepted when q = err / (tol max(Δ, rate_floor 2h/T)) ≤ 1, or when
-h = k_min already. This controls the local time lag err/|y'| of the
-pair rather than its error per unit time: an error made early in a
-debonding is carried to the end as a lag of the front, and the error of a
-lag grows with the front's speed (studies/convergence/adaptive). The next
-half step (after a rejection, the retried one) is
+β weighted by the facet measures. What is controlled is the pair's time
+lag ℓ = 2h err / Δ (its error over its rate of change), Δ = ‖y_{t+2h} −
+y_t‖ the pair's change in the same norm floored at ``rate_floor`` 2h/T (a
+quiet stretch counts as changing at that rate): the pair is accepted when
 
-    h_new = h · min(growth, max(shrink, safety · q^{−1/p}))
+    q = ℓ / (tol T_ℓ) = err 2h / (tol T_ℓ max(Δ, rate_floor 2h/T)) ≤ 1,   T_ℓ = T/64,
+
+or when h = k_min already. An error made early in a debonding is carried
+to the end as a lag of the front (the error of a lag grows with the
+front's speed: studies/convergence/adaptive), and the lags of the pairs add
+up; with ℓ = a h^{p+1} the fewest steps (∫ dt/h) for a given sum
+(∫ a h^p dt) make a h^{p+1} the same for every pair (Lagrange), so the lag
+per pair, not per unit time, is what the grid spreads evenly. T_ℓ = T/64
+makes q at 2h = T/64 the relative change err/(tol Δ). The next half step
+(after a rejection, the retried one) is
+
+    h_new = h · min(growth, max(shrink, safety · q^{−1/(p+1)}))
 
 rounded down to the quantised set, capped at the explicit Euler bound of
 the bonding law (2h ≤ k_E, the doubled step included) and at what is left
-of [0, T]. With err ∝ h^{p+1} and Δ ∝ h, q ∝ h^p: the exponent 1/p makes
-q ≈ safety^p.
+of [0, T]. With err ∝ h^{p+1} and Δ ∝ h, q ∝ h^{p+1}: the exponent
+1/(p+1) makes q ≈ safety^{p+1} (the memory's criterion, per unit time, q ∝
+h^p: exponent 1/p).
 """
 
 import math
@@ -138,31 +145,43 @@ class Controller:
                    2 if scene.scheme == "second-order" else 1, a.rate_floor, a.growth,
                    a.shrink, a.safety, memory_time(scene))
 
-    def ratio(self, err, j, change=0.0, memory=0.0):
-        """q = max(err / (tol max(Δ, rate_floor 2h_j/T)), err_H τ / (tol 2h_j)),
-        Δ = ``change`` of the pair, err_H = ``memory`` the memory's estimate
-        and τ = ``memory_time`` (the kernel's shortest relaxation time)."""
-        h2 = 2.0 * self.sizes.size(j)
-        q = err / (self.tol * max(change, self.rate_floor * h2 / self.T))
-        if memory > 0.0:
-            q = max(q, memory * self.memory_time / (self.tol * h2))
-        return q
+    #: T_ℓ = T/LAG_SPAN: the lag a pair may make is tol T_ℓ
+    LAG_SPAN = 64
 
-    def factor(self, q):
-        """min(growth, max(shrink, safety q^{−1/p}))."""
-        if q <= 0.0:
+    def ratios(self, err, j, change=0.0, memory=0.0):
+        """(q_ℓ, q_H): the lag's q_ℓ = err 2h_j / (tol T_ℓ max(Δ, rate_floor
+        2h_j/T)), Δ = ``change`` of the pair, and the memory's q_H = err_H τ
+        / (tol 2h_j), err_H = ``memory`` its estimate and τ =
+        ``memory_time`` (the kernel's shortest relaxation time)."""
+        h2 = 2.0 * self.sizes.size(j)
+        lag = err * h2 * self.LAG_SPAN / (
+            self.tol * self.T * max(change, self.rate_floor * h2 / self.T))
+        held = memory * self.memory_time / (self.tol * h2) if memory > 0.0 else 0.0
+        return lag, held
+
+    def ratio(self, err, j, change=0.0, memory=0.0):
+        """q = max(q_ℓ, q_H) of :meth:`ratios`: the pair passes at q ≤ 1."""
+        return max(self.ratios(err, j, change, memory))
+
+    def factor(self, lag, held=0.0):
+        """min(growth, max(shrink, safety min(q_ℓ^{−1/(p+1)}, q_H^{−1/p}))):
+        q_ℓ ∝ h^{p+1}, q_H ∝ h^p."""
+        shares = [q ** (-1.0 / e) for q, e in ((lag, self.order + 1), (held, self.order))
+                  if q > 0.0]
+        if not shares:
             return self.growth
-        return min(self.growth, max(self.shrink, self.safety * q ** (-1.0 / self.order)))
+        return min(self.growth, max(self.shrink, self.safety * min(shares)))
 
     def judge(self, err, j, at, change=0.0, memory=0.0):
         """(accept, next j) for a pair of half steps h_j starting at unit
         ``at`` with estimated error ``err`` and change Δ = ``change``; the
         next j is that of the pair after it (accepted: from ``at + 2
         span(j)``) or of the retry."""
-        q = self.ratio(err, j, change, memory)
+        lag, held = self.ratios(err, j, change, memory)
+        q = max(lag, held)
         finite = math.isfinite(q)
         accept = (finite and q <= 1.0) or j == self.sizes.halvings
-        target = self.sizes.size(j) * (self.factor(q) if finite else self.shrink)
+        target = self.sizes.size(j) * (self.factor(lag, held) if finite else self.shrink)
         if accept:
             self.accepted += 1
             self.forced += not (finite and q <= 1.0)

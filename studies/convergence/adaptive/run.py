@@ -2,6 +2,7 @@
 
     python studies/convergence/adaptive/run.py [--tols 0.1 ... 0.001] [--steps 32 ... 2048]
                                                [--reference 16384] [--held]
+                                               [--scheme second-order]
 
 The scene is (h) of studies/convergence (``../h_debonding_strip.toml``: a
 glued strip with memory, slip weakening and Frémond bonding, peeled and
@@ -18,6 +19,11 @@ the relative L² error of u plus the rms of β over Γ_C, max over the run's
 levels. For each adaptive run the uniform N with the same E is read off
 the uniform curve (log-log interpolation); the goal is an adaptive run
 with at most half those steps at every tol, and some tol with E ≤ 0.05.
+
+``--scheme second-order`` runs both the uniform grids and the adaptive ones
+with ``time.scheme = "second-order"`` (results in ``results/second_order/``,
+or ``results/held/second_order/``), against a uniform reference of the same
+scheme (4096 steps by default: its own error is far below the runs').
 
 Writes ``results/adaptive.csv``, ``results/uniform.csv`` and
 ``results/adaptive.png``; every run's numbers are kept in ``results/runs/``
@@ -54,6 +60,7 @@ REFERENCE = 16384
 #: followed by relaxation (k_max = T/32 again, within the explicit bound)
 HELD = {"T": 2.0, "right": ["7*minimum(t, 0.8)", "14*minimum(t, 0.8)"]}
 held = False
+SCHEME = "paper"   # --scheme: time.scheme of every run
 
 
 def scene(steps=32, tol=None, scheme="paper"):
@@ -80,14 +87,14 @@ def mass_matrix(mesh):
     return asm(mass, Basis(mesh, ElementTriP1()))
 
 
-def reference(steps=REFERENCE):
+def reference(steps=REFERENCE, scheme="paper"):
     """(t, u, beta, seconds) of the uniform reference, saved once."""
     path = RESULTS / f"reference_{steps}.npz"
     if path.is_file():
         with np.load(path) as data:
             return data["t"], data["u"], data["beta"], float(data["seconds"])
     t0 = time.perf_counter()
-    solution = solve(build_problem(scene(steps)), raise_on_failure=True)
+    solution = solve(build_problem(scene(steps, scheme=scheme)), raise_on_failure=True)
     seconds = time.perf_counter() - t0
     RESULTS.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, t=solution.t, u=solution.u, beta=solution.beta,
@@ -158,19 +165,30 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tols", type=float, nargs="+", default=TOLS)
     parser.add_argument("--steps", type=int, nargs="+", default=STEPS)
-    parser.add_argument("--reference", type=int, default=REFERENCE)
+    parser.add_argument("--reference", type=int, default=None,
+                        help=f"uniform steps of the reference ({REFERENCE}; 4096 for "
+                             "--scheme second-order)")
     parser.add_argument("--held", action="store_true",
                         help="the load held from t = 0.8 to T = 2 (results/held/)")
+    parser.add_argument("--scheme", choices=("paper", "second-order"), default="paper",
+                        help="time.scheme of every run (results/.../second_order/)")
     args = parser.parse_args()
-    global RESULTS, held
+    global RESULTS, held, SCHEME
     if args.held:
         held, RESULTS = True, RESULTS / "held"
-    ref = reference(args.reference)
+    SCHEME = args.scheme
+    if args.scheme != "paper":
+        RESULTS = RESULTS / "second_order"
+    if args.reference is None:
+        args.reference = REFERENCE if args.scheme == "paper" else 4096
+    ref = reference(args.reference, args.scheme)
     problem = build_problem(scene())
     M = mass_matrix(problem.mesh)
     measure = np.asarray(problem.boundary.measure, dtype=float)
-    uniform = [run(f"uniform_{N}", scene(N), ref, M, measure) for N in args.steps]
-    adaptive = [dict(run(f"adaptive_{tol:g}", scene(tol=tol), ref, M, measure), tol=tol)
+    uniform = [run(f"uniform_{N}", scene(N, scheme=args.scheme), ref, M, measure)
+               for N in args.steps]
+    adaptive = [dict(run(f"adaptive_{tol:g}", scene(tol=tol, scheme=args.scheme), ref, M,
+                         measure), tol=tol)
                 for tol in args.tols]
     for record in adaptive:
         record["uniform_steps"] = uniform_steps_for(record["E"], uniform)
@@ -185,7 +203,7 @@ def main():
               [(r["tol"], r["steps"], r["E"], r["e_u"], r["e_beta"], r["uniform_steps"],
                 r["ratio"], r["step_solves"], r["rejected_pairs"], r["forced_pairs"],
                 r["k_smallest"], r["k_largest"], r["seconds"]) for r in adaptive])
-    print(f"reference: {args.reference} uniform steps, {ref[3]:.1f} s")
+    print(f"reference: {args.reference} uniform steps ({args.scheme}), {ref[3]:.1f} s")
     print(f"{'N':>6} {'E':>10} {'seconds':>8}")
     for r in uniform:
         print(f"{r['steps']:6d} {r['E']:10.4g} {r['seconds']:8.2f}")
@@ -207,7 +225,7 @@ def plot(uniform, adaptive):
     for key, ax, label in (("steps", axes[0], "accepted steps"),
                            ("seconds", axes[1], "wall time (s)")):
         ax.loglog([r[key] for r in uniform], [r["E"] for r in uniform], "o-",
-                  label="uniform (paper's scheme)")
+                  label=f"uniform ({SCHEME})")
         ax.loglog([r[key] for r in adaptive], [r["E"] for r in adaptive], "s-",
                   label="adaptive (step doubling)")
         for r in adaptive:
@@ -217,7 +235,7 @@ def plot(uniform, adaptive):
         ax.set_ylabel("E (u rel. L² + β rms, max over levels)")
         ax.legend(fontsize=8)
     fig.suptitle("(h) debonding strip" + (", load held from t = 0.8 to T = 2" if held else "")
-                 + ": adaptive against uniform steps")
+                 + f": adaptive against uniform steps, {SCHEME} scheme")
     fig.tight_layout()
     fig.savefig(RESULTS / "adaptive.png", dpi=120)
 
