@@ -60,7 +60,6 @@ REFERENCE = 16384
 #: followed by relaxation (k_max = T/32 again, within the explicit bound)
 HELD = {"T": 2.0, "right": ["7*minimum(t, 0.8)", "14*minimum(t, 0.8)"]}
 held = False
-SCHEME = "paper"   # --scheme: time.scheme of every run
 
 
 def scene(steps=32, tol=None, scheme="paper"):
@@ -173,10 +172,9 @@ def main():
     parser.add_argument("--scheme", choices=("paper", "second-order"), default="paper",
                         help="time.scheme of every run (results/.../second_order/)")
     args = parser.parse_args()
-    global RESULTS, held, SCHEME
+    global RESULTS, held
     if args.held:
         held, RESULTS = True, RESULTS / "held"
-    SCHEME = args.scheme
     if args.scheme != "paper":
         RESULTS = RESULTS / "second_order"
     if args.reference is None:
@@ -213,10 +211,10 @@ def main():
         print(f"{r['tol']:6g} {r['steps']:6d} {r['E']:10.4g} {r['uniform_steps']:9.0f} "
               f"{r['ratio']:6.2f} {r['step_solves']:7d} {r['rejected_pairs']:8d} "
               f"{r['seconds']:8.2f}")
-    plot(uniform, adaptive)
+    plot(uniform, adaptive, args.scheme)
 
 
-def plot(uniform, adaptive):
+def plot(uniform, adaptive, scheme):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -225,7 +223,7 @@ def plot(uniform, adaptive):
     for key, ax, label in (("steps", axes[0], "accepted steps"),
                            ("seconds", axes[1], "wall time (s)")):
         ax.loglog([r[key] for r in uniform], [r["E"] for r in uniform], "o-",
-                  label=f"uniform ({SCHEME})")
+                  label=f"uniform ({scheme})")
         ax.loglog([r[key] for r in adaptive], [r["E"] for r in adaptive], "s-",
                   label="adaptive (step doubling)")
         for r in adaptive:
@@ -235,7 +233,7 @@ def plot(uniform, adaptive):
         ax.set_ylabel("E (u rel. L² + β rms, max over levels)")
         ax.legend(fontsize=8)
     fig.suptitle("(h) debonding strip" + (", load held from t = 0.8 to T = 2" if held else "")
-                 + f": adaptive against uniform steps, {SCHEME} scheme")
+                 + f": adaptive against uniform steps, {scheme} scheme")
     fig.tight_layout()
     fig.savefig(RESULTS / "adaptive.png", dpi=120)
 
