@@ -109,6 +109,7 @@ def main():
     from adhesive_contact.storage import write_atomic, write_json
 
     out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
     write_json(out / "ratio.json", {"machine": describe(), "rows": rows})
 
     def table(f):
