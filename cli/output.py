@@ -36,7 +36,7 @@ from .summary import energy_record, smallness_record, step_records
 
 #: the version of summary.json's layout (docs/outputs.md): raised when a key
 #: changes meaning or goes; new keys do not change it
-SCHEMA = 1
+SCHEMA = 2
 
 
 def summary(solution, source=None, history=None, lines=None):

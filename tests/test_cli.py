@@ -130,7 +130,7 @@ def test_the_history_is_stored_uncompressed_and_the_rest_compressed(solved):
 def test_summary_has_one_record_per_level(solved):
     _, out, _ = solved
     summary = strict_json(out / "summary.json")
-    assert set(summary) == SUMMARY_KEYS and summary["schema"] == 1
+    assert set(summary) == SUMMARY_KEYS and summary["schema"] == 2
     assert summary["scene"]["title"] == "test block"
     assert set(summary["smallness"]) == SMALLNESS_KEYS
     assert isinstance(summary["warnings"], list)

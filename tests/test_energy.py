@@ -205,7 +205,7 @@ def test_moving_wall_does_work():
     problem, solution = run(scene)
     assert solution.on_wall[-1].any()
     e = energies(solution)
-    *_, bregman, wall, _ = contact_energies(solution)
+    *_, bregman, wall = contact_energies(solution)
     assert wall.sum() > 0
     assert np.all(np.diff(e.dissipated["numerical"]) >= 0)
     assert (bregman - wall).min() < 0

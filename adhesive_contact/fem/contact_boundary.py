@@ -205,6 +205,16 @@ class ContactBoundary:
         g[self.held_axes] = prescribed[self.held_positions]
         return np.where(self.held, np.einsum("aic,ai->ac", self.frame, g), 0.0).ravel()
 
+    def held_forces(self, frame_force, size):
+        """The transpose of :meth:`held_values`: frame components (nc·d,) of
+        nodal forces, read at the held components, as forces on the held
+        dofs (``size`` of them, ``fixed`` order; 0 at the held dofs off
+        Γ_C): R_a F_a at each held Cartesian component."""
+        F = np.where(self.held, np.asarray(frame_force).reshape(self.held.shape), 0.0)
+        out = np.zeros(size)
+        out[self.held_positions] = np.einsum("aic,ac->ai", self.frame, F)[self.held_axes]
+        return out
+
     def at_points(self, facet_values):
         """A P0 field (nf,) read at the quadrature points (nq,)."""
         return facet_values[self.facet_of_point]

@@ -23,7 +23,7 @@ from .npz import SOLUTION_KEYS
 #: summary.json's run.status -> Solution.status
 STATUS = {"complete": SUCCESS, "step failed": STEP_FAILED, "interrupted": STOPPED}
 #: the summary.json layout this reads
-SCHEMA = 1
+SCHEMA = 2
 
 
 class OutputFolderError(ValueError):
@@ -36,7 +36,7 @@ class OutputFolderError(ValueError):
 
 
 def read_summary(path):
-    """The ``summary.json`` document at ``path``, of this layout (schema 1)."""
+    """The ``summary.json`` document at ``path``, of this layout (schema :data:`SCHEMA`)."""
     try:
         document = json.loads(Path(path).read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -53,7 +53,7 @@ def read_summary(path):
     if not isinstance(document, dict) or document.get("schema") != SCHEMA:
         found = document.get("schema") if isinstance(document, dict) else None
         raise OutputFolderError(path, f"has schema {found!r}; this version reads schema "
-                                f"{SCHEMA}")
+                                f"{SCHEMA}: run the scene again with it")
     for key in ("scene", "run", "steps"):
         if key not in document:
             raise OutputFolderError(path, f"has no {key!r}: the file is damaged")

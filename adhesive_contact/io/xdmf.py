@@ -132,8 +132,8 @@ class XdmfSeries:
 
     def _nodal(self, level):
         """The contact fields of a level at the points of ``contact.xdmf``
-        (every vertex of Γ_C is a contact node; the force is 0 along a
-        held component, being in the side's reaction)."""
+        (every vertex of Γ_C is a contact node; along a held component
+        the force is the contact laws' there)."""
         at = getattr(level, "index", None)   # an adaptive run: its index on a finer grid
         at = level.n if at is None else at
         gap = None if self.problem.gap is None else self.problem.gap[at]

@@ -10,12 +10,12 @@ with Δu_n = u_n − u_{n−1} (u_{−1} = 0, the scheme's initial state):
 
     (σ_n, ε(Δu_n)) = ⟨f(t_n), Δu_n⟩ + r_n·Δg_D + F_n·Δz_n,
 
-r_n the reactions of the held dofs, F_n the force of Γ_C on the body (the
-contact laws and the wall), z the nodal-frame displacements of the contact
-nodes. At a contact node with a held component the laws' force along it,
-F = −∇_z Φ there, is part of the recorded reaction r_n
-(docs/conventions.md): the work below counts the supports' share
-r_n − F_n only, and F_n·Δz_n holds every component. Its terms:
+r_n the reactions of the held dofs (the supports' force alone), F_n the
+force of Γ_C on the body (the contact laws and the wall), z the nodal-frame
+displacements of the contact nodes. At a contact node with a held component
+F_n holds the laws' force along it, F = −∇_z Φ there (docs/conventions.md),
+so F_n·Δz_n holds every component and r_n·Δg_D the supports' work. Its
+terms:
 
 - **work** W_n = Σ_{m≤n} ⟨f(t_m), Δu_m⟩ + r_m·Δg_D,m (+ the work of a
   moving wall, −λ_m·Δg_m): the right rectangle rule of the scheme;
@@ -244,15 +244,14 @@ class ContactPotentials:
 
 def contact_energies(solution):
     """(layer, glue, friction) stored per level, the increments D^b_n of the
-    debonding and B_n of the contact's numerical dissipation, the work of a
-    moving wall and the work of the contact laws along held components per
-    level: seven (M+1,) arrays (module docstring)."""
+    debonding and B_n of the contact's numerical dissipation and the work of
+    a moving wall per level: six (M+1,) arrays (module docstring)."""
     problem = solution.problem
     levels = solution.t.size
     b = problem.boundary
     if b is None or b.facets.size == 0:
         zeros = np.zeros(levels)
-        return zeros, zeros, zeros, zeros, zeros.copy(), zeros.copy(), zeros.copy()
+        return zeros, zeros, zeros, zeros, zeros.copy(), zeros.copy()
     potentials = ContactPotentials(problem)
     z = solution.frame_displacement.reshape(levels, -1).T                  # (nz, L)
     z_old = np.concatenate([np.zeros((z.shape[0], 1)), z[:, :-1]], axis=1)
@@ -262,15 +261,6 @@ def contact_energies(solution):
     at_old = potentials.total(beta, z_old)
     debonding = potentials.total(beta_old, z_old) - at_old
     force = solution.contact_force.reshape(levels, -1).T
-    held_work = np.zeros(levels)
-    held = b.held.ravel() if b.has_held else None
-    if held is not None and held.any():
-        # along a held component the laws' force F = −∇Φ (no wall acts there)
-        # is in the side's reaction, not in contact_force: put it in F, and
-        # take its work out of the reactions' (module docstring)
-        force = force.copy()
-        force[held] = -potentials.law_force(beta, z)[held]
-        held_work = np.sum(force[held] * (z - z_old)[held], axis=0)
     wall = np.zeros(levels)
     gap = problem.gap
     if gap is not None and gap.shape[1]:
@@ -283,7 +273,7 @@ def contact_energies(solution):
             lam = -(force + potentials.law_force(beta, z))[normal].T * solution.on_wall
             wall = -np.sum(lam * dg, axis=1)
     bregman = at_old - (layer + glue + friction) + np.sum(force * (z_old - z), axis=0) + wall
-    return layer, glue, friction, debonding, bregman, wall, held_work
+    return layer, glue, friction, debonding, bregman, wall
 
 
 def external_work_increments(solution):
@@ -316,8 +306,8 @@ def energies(solution):
     if energy_unavailable(problem) is not None:
         return None
     elastic, memory, viscous, numerical = bulk_energies(problem, solution.u)
-    layer, glue, friction, debonding, bregman, wall, held = contact_energies(solution)
-    work = np.cumsum(external_work_increments(solution) + wall - held)
+    layer, glue, friction, debonding, bregman, wall = contact_energies(solution)
+    work = np.cumsum(external_work_increments(solution) + wall)
     return EnergyHistory(
         t=np.asarray(solution.t, dtype=float).copy(), external_work=work,
         stored={"elastic": elastic, "memory": memory, "layer": layer, "glue": glue,

@@ -110,6 +110,25 @@ class ContactEnergy:
         xi = np.stack([t @ z for t in self.T], axis=-1)
         return xi if self.t0 is None else xi + self.t0
 
+    def held_gradient(self, z):
+        """∂Φ/∂z_D (nh,): the gradient of Φ in the held frame components
+        (those of ``held``, node-major indices into the nc·d frame
+        components) at z, the held values of :meth:`set_held` in place;
+        −∂Φ/∂z_D is the force of the contact laws on the body along them.
+        At ξ_q = 0 the friction part is left out, as in :meth:`gradient`
+        (its least-norm subgradient; the kink's force along a held slip is
+        not determined by the step)."""
+        g = np.zeros(self.held.size)
+        if self.held.size == 0:
+            return g
+        if self.normal_law.active:
+            g += self.N_held.T @ (self.w * self.normal_law.value(self.beta, self.normal(z)))
+        if self.friction is not None:
+            force = self.w[:, None] * self.friction.gradient(self.beta, self.tangential(z))
+            for i, t in enumerate(self.T_held):
+                g += t.T @ force[:, i]
+        return g
+
     def value(self, z):
         out = 0.0
         if self.normal_law.active:

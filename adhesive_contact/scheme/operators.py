@@ -206,13 +206,15 @@ class StepOperators:
         """a_FD g_D: the force of the held values g (nD,) on the free dofs of level n."""
         return self.support[0 if n == 0 else 1][0] @ g
 
-    def reaction(self, n, u_frame, f):
-        """(a_n u)_D − f_D of level n on the held dofs, from the whole
-        nodal-frame ũ (ndofs,) (the rows of a_n R at the held dofs) and the
-        load f_D on the held dofs (the memory history subtracted): the force
-        the support exerts on the body, with that of the contact laws along
-        a held component of a contact node."""
-        return self.support[0 if n == 0 else 1][1] @ u_frame - f
+    def reaction(self, n, u_frame, f, contact=None):
+        """(a_n u)_D − f_D − F_D of level n on the held dofs, from the whole
+        nodal-frame ũ (ndofs,) (the rows of a_n R at the held dofs), the
+        load f_D on the held dofs (the memory history subtracted) and the
+        contact laws' force F_D (nD,) along the held components of the
+        contact nodes (None: none): the force the support alone exerts on
+        the body, what a load cell in the grip reads."""
+        r = self.support[0 if n == 0 else 1][1] @ u_frame - f
+        return r if contact is None else r - contact
 
     def held_frames(self, g):
         """ũ_D: the held values g_D (nD,) as components of ũ."""

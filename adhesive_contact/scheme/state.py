@@ -47,13 +47,13 @@ class Level:
     stress: np.ndarray            # (ncells, d, d)
     stress_zz: np.ndarray         # (ncells,) plane strain σ_zz, or None in 3D
     contact_force: np.ndarray     # (nc, d) force of Γ_C on the body, nodal frames
-                                  # (0 at a held component: in the reaction)
+                                  # (the contact laws' alone at a held component)
     frame_displacement: np.ndarray  # (nc, d)
     on_wall: np.ndarray           # (nc,) bool
     stuck: np.ndarray             # (nc,) bool
     probes: np.ndarray            # (nprobes, d)
-    reaction: np.ndarray          # (nD,) force of the support on the body per held dof
-                                  # (with the contact laws' force along it)
+    reaction: np.ndarray          # (nD,) force of the support alone on the body per
+                                  # held dof (the contact laws' is in contact_force)
     iterations: int
     residual: float
     index: int = None             # its index in problem.times when that is not n (an
@@ -382,9 +382,9 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0, z_before=N
 
     The force of Γ_C at a free component of a contact node is its reaction
     in the frame equations (S z − c). At a held component the contact laws
-    act too (at the prescribed value), but their force there has no
-    equation: it is part of the reaction (a_n u)_D − f_D of the held dof,
-    and ``contact_force`` is 0 there, so that Σ_sides R + Σ_a R_a F_a + ∫ f = 0.
+    act too (at the prescribed value), F_D = −∂Φ/∂z_D: ``contact_force``
+    holds it there, and the support's force is what is left of the held
+    rows, R = (a_n u)_D − f_D − F_D, so that Σ_sides R + Σ_a R_a F_a + ∫ f = 0.
 
     ``z0`` the step unknowns of level n − 1, ``z_before`` those of level
     n − 2 (for the predictor of :meth:`ContactStep.predictor`), or None.
@@ -407,9 +407,15 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0, z_before=N
         u_free, z, c, result = free_solve(step, contact, n, b, beta, z0, before=z_before)
     if u_free is None:
         return None, None, None, z0, result
+    held_force = None
     if contact is not None:
-        # the force of Γ_C on the body: its reaction in the frame equations
+        # the force of Γ_C on the body: its reaction in the frame equations at
+        # the free components, −∂Φ/∂z_D of the laws at the held ones
         force.reshape(-1)[problem.columns] = (step.S @ z - c)[contact.unknowns]
+        if contact.energy.held.size:
+            force.reshape(-1)[contact.energy.held] = -contact.energy.held_gradient(z)
+            held_force = problem.boundary.held_forces(force.reshape(-1),
+                                                      problem.prescribed.fixed.size)
         normal = problem.normal_columns
         on_wall[problem.columns[normal] // d] = result.on_wall[contact.unknowns][normal]
         if contact.kink is not None and problem.friction.has_kink:
@@ -431,7 +437,7 @@ def step_solve(problem, operators, contact, n, t, b, beta, known, z0, z_before=N
         contact_force=force, frame_displacement=frame_u.reshape(nc, d), on_wall=on_wall,
         stuck=stuck, probes=(problem.probe_map @ points if problem.probe_map is not None
                              else np.zeros((0, d))),
-        reaction=operators.reaction(n, u_frame, known.held_load),
+        reaction=operators.reaction(n, u_frame, known.held_load, held_force),
         iterations=0 if result is None else result.nit,
         residual=0.0 if result is None else result.residual)
     return level, u, frame_u, z, result
