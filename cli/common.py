@@ -35,8 +35,10 @@ def read_scene(path):
         text = resources.files("adhesive_contact_cli").joinpath(DEFAULT_SCENE).read_text(
             encoding="utf-8")
         return "default", text
+    from adhesive_contact.scene.parse import read_scene_text
+
     try:
-        return path.stem, path.read_text(encoding="utf-8")
+        return path.stem, read_scene_text(path)
     except FileNotFoundError:
         raise CliError(f"SCENE: no such file {str(path)!r}", 2) from None
     except (OSError, UnicodeDecodeError) as err:

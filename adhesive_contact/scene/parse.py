@@ -8,6 +8,9 @@ geometry-dependent checks (a probe outside the mesh, a negative gap, side
 names that a mesh file does not have) are made when the problem is built.
 """
 
+import errno
+import os
+import stat
 import tomllib
 from dataclasses import replace
 from pathlib import Path
@@ -100,8 +103,35 @@ def parse_scene(text, base_dir=None):
     return scene_from_dict(data, base_dir)
 
 
-def load_scene(path):
-    """Read and parse the scene file ``path``; a relative ``mesh.file`` is
-    taken in the scene file's folder. OSError if the file cannot be read."""
+#: the largest scene file read: a scene is a page of TOML (the largest
+#: committed one is under 4 KiB); anything past this is not a scene
+MAX_SCENE_BYTES = 1 << 20
+
+
+def read_scene_text(path):
+    """The text of the scene file ``path``. Only a regular file of at most
+    MAX_SCENE_BYTES is read: a FIFO would block the read, a device such as
+    /dev/zero never ends, so anything else is refused before it is opened
+    (OSError with a sentence as its ``strerror``); UnicodeDecodeError for
+    a file that is not UTF-8."""
     path = Path(path)
-    return parse_scene(path.read_text(encoding="utf-8"), base_dir=path.parent)
+    mode = os.stat(path).st_mode   # FileNotFoundError for a missing file
+    if not stat.S_ISREG(mode):
+        kind = ("a folder" if stat.S_ISDIR(mode) else "a named pipe (FIFO)"
+                if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
+                stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "not a file")
+        raise OSError(errno.EINVAL, f"{kind}, not a regular file; give a scene file (TOML)")
+    with open(path, "rb") as f:
+        data = f.read(MAX_SCENE_BYTES + 1)
+    if len(data) > MAX_SCENE_BYTES:
+        raise OSError(errno.EFBIG, f"larger than {MAX_SCENE_BYTES >> 20} MiB, which no scene "
+                      "is; give a scene file (TOML)")
+    return data.decode("utf-8")
+
+
+def load_scene(path):
+    """Read and parse the scene file ``path`` (:func:`read_scene_text`); a
+    relative ``mesh.file`` is taken in the scene file's folder. OSError if
+    the file cannot be read or is no regular file of scene size."""
+    path = Path(path)
+    return parse_scene(read_scene_text(path), base_dir=path.parent)
