@@ -162,7 +162,9 @@ class _Run:
         self.keep(level, 0)
         if self.stop():
             return (SUCCESS if sizes.units == 0 else STOPPED), None
-        at, j = 0, sizes.first   # the largest step; a rejection shrinks it
+        # the largest step whose pair fits in [0, T] (one uniform step,
+        # time.steps = 1, leaves pairs of k_max/2); a rejection shrinks it
+        at, j = 0, sizes.index(sizes.size(sizes.first), 0)
         while at < sizes.units:
             notes = self.notes()
             big, failure = self.trial(state, at, j - 1)
