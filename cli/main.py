@@ -104,26 +104,34 @@ def level_status(level):
     return f"t = {level.t:.4g}, {level.iterations} Newton iterations"
 
 
+#: the signals that ask a run to stop at the end of its step, and the exit
+#: code of a run they stopped (128 + the signal's number, as a shell reports)
+STOP_SIGNALS = {signal.SIGINT: 130, signal.SIGTERM: 143}
+
+
 @contextlib.contextmanager
 def interruptible():
-    """A block in which Ctrl-C (SIGINT) asks the run to stop at the end of
-    the current step instead of killing it: yields a function that says
-    whether it was pressed. A second Ctrl-C interrupts at once."""
-    pressed = []
+    """A block in which Ctrl-C (SIGINT) or SIGTERM (what a batch system
+    sends before it kills a job) asks the run to stop at the end of the
+    current step instead of killing it: yields a function that returns the
+    first such signal received (0 for none). A second one interrupts at
+    once."""
+    received = []
 
     def handler(signum, frame):
-        if pressed:
+        if received:
             raise KeyboardInterrupt
-        pressed.append(signum)
+        received.append(signum)
 
     if threading.current_thread() is not threading.main_thread():
-        yield lambda: False
+        yield lambda: 0
         return
-    previous = signal.signal(signal.SIGINT, handler)
+    previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
     try:
-        yield lambda: bool(pressed)
+        yield lambda: received[0] if received else 0
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, action in previous.items():
+            signal.signal(sig, action)
 
 
 class LazyGroup(OneLineGroup):
@@ -200,7 +208,8 @@ def solve_command(scene, out, force, quiet):
                         as bar, interruptible() as interrupted:
                     solution = solve(problem, recorder=recorder,
                                      progress=lambda n, N: bar.update(1, recorder.last)
-                                     or interrupted())
+                                     or bool(interrupted()))
+                    stopped_by = interrupted()
                 # a partial run never replaces a complete earlier one
                 kept = not solution.success and holds_complete_run(out)
                 if solution.t.size and not kept:   # the levels that converged
@@ -223,10 +232,11 @@ def solve_command(scene, out, force, quiet):
                    "complete earlier run, which is kept (use another --out to keep a "
                    "partial run)")
     if solution.status == STOPPED:
-        raise CliError(f"interrupted after step {solution.steps} (t = {solution.t[-1]:g}); "
+        by = "" if stopped_by != signal.SIGTERM else " by SIGTERM"
+        raise CliError(f"interrupted{by} after step {solution.steps} (t = {solution.t[-1]:g}); "
                        + (not_written if kept else
                           f"the {solution.t.size} levels done were written to {out}/ "
-                          "(summary.json: run.partial = true)"), 130)
+                          "(summary.json: run.partial = true)"), STOP_SIGNALS.get(stopped_by, 130))
     if not solution.success:
         written = (f"The {solution.t.size} levels before it were written to {out}/ "
                    "(summary.json: run.partial = true)." if files else

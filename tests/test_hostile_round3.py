@@ -68,3 +68,68 @@ def test_the_library_refuses_a_scene_path_that_is_no_regular_file(tmp_path):
         load_scene(tmp_path / "pipe.toml")
     with pytest.raises(OSError, match="a device"):
         load_scene("/dev/zero")
+
+
+# ---------------------------------------------------------------- values past what the numbers hold
+
+from conftest import assert_one_line_error, invoke, law, scene_dict, to_toml  # noqa: E402
+
+BASE = scene_dict({"contact.normal": law("compliance", c=1e4),
+                   "loads": {"body": ["0", "-10*t"]}, "time.steps": 2})
+
+
+@pytest.mark.parametrize("changes, needle", [
+    ({"material.E": 5e-324}, "material.E: gives the elastic tensor mu = 0, bulk modulus 0, "
+                             "below 1e-100, where the stiffness matrix underflows"),
+    ({"material.E": 1e-310}, "material.E: gives the elastic tensor mu = 3.85e-311"),
+    ({"material": {"lam": 1.0, "mu": 1e-200}}, "material.mu: gives the elastic tensor mu = 1e-200"),
+    ({"material": None, "memory": {"kernel": "relaxation", "long_term": {"E": 1e-300, "nu": 0.3},
+                                   "terms": [{"E": 100.0, "tau": 1.0}]}},
+     "memory.long_term: gives the long-term tensor of the relaxation kernel mu = 3.85e-301"),
+    ({"time.T": 5e-324}, "time.T: gives the time step k = T/steps = 0, below 1e-100"),
+    ({"time.T": 1e-250, "time.steps": 3}, "time.T: gives the time step k = T/steps = 3.33e-251"),
+])
+@pytest.mark.parametrize("command", ["check", "solve"])
+def test_moduli_and_steps_past_double_precision_are_refused(tmp_path, changes, needle, command):
+    """E = 5e-324 or 1e-310 made a singular factorisation (a traceback; a
+    sweep with it crashed whole; check exited 0); T = 5e-324 gave k = 0
+    and every level at t = 0, exit 0."""
+    data = scene_dict({k: v for k, v in changes.items() if v is not None}, BASE)
+    for k, v in changes.items():
+        if v is None:
+            del data[k]
+    (tmp_path / "s.toml").write_text(to_toml(data))
+    args = [command, str(tmp_path / "s.toml")] + (["--out", str(tmp_path / "o")]
+                                                  if command == "solve" else [])
+    assert_one_line_error(invoke(*args), 2, needle)
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_long_unknown_key_is_shown_cut_in_one_short_line(tmp_path):
+    """A 10,000-character unknown key made a 10,059-character error line."""
+    data = scene_dict({"contact.normal": {"law": "compliance", "c": 1e4, "x" * 10000: 1}}, BASE)
+    (tmp_path / "s.toml").write_text(to_toml(data))
+    result = invoke("check", str(tmp_path / "s.toml"))
+    assert_one_line_error(result, 2, "unknown key; allowed here: c, law")
+    assert len(result.stderr.strip()) < 200 and "…" in result.stderr
+
+
+def test_adaptive_steps_from_one_uniform_step(tmp_path):
+    """[time.adaptive] with time.steps = 1: the first pair took a doubled
+    step of 2T (IndexError in solve, converge --param k and a sweep, which
+    died instead of writing a row); now its pairs are of k_max/2 = T/2."""
+    import json
+
+    data = scene_dict({"time.steps": 1, "time.adaptive": {"tol": 0.01}}, BASE)
+    (tmp_path / "s.toml").write_text(to_toml(data))
+    result = invoke("solve", tmp_path / "s.toml", "--out", tmp_path / "o")
+    assert result.exit_code == 0, result.stderr
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    t = [s["t"] for s in summary["steps"]]
+    assert t[0] == 0.0 and t[-1] == 1.0 and all(b > a for a, b in zip(t, t[1:]))
+    assert summary["adaptive"]["accepted_steps"] == len(t) - 1 >= 2
+    sweep = invoke("sweep", tmp_path / "s.toml", "--set", "contact.normal.c=1e3,1e4",
+                   "--out", tmp_path / "sw")
+    assert sweep.exit_code == 0, sweep.stderr
+    rows = (tmp_path / "sw" / "runs.csv").read_text().splitlines()
+    assert len(rows) == 3 and all(",ok," in row for row in rows[1:])

@@ -31,7 +31,13 @@ SCENE_DICT = scene_dict({
 SCENE = to_toml(SCENE_DICT)
 
 
-def test_ctrl_c_stops_at_the_end_of_a_step_and_keeps_the_levels_done(tmp_path):
+@pytest.mark.parametrize("sig, exit_code, said", [(signal.SIGINT, 130, "interrupted after step"),
+                                             (signal.SIGTERM, 143,
+                                              "interrupted by SIGTERM after step")])
+def test_ctrl_c_stops_at_the_end_of_a_step_and_keeps_the_levels_done(tmp_path, sig, exit_code, said):
+    """Ctrl-C, and SIGTERM (what a batch system sends before its kill: it
+    used to end the run at once and leave nothing), stop at the end of a
+    step and write the levels done."""
     (tmp_path / "scene.toml").write_text(SCENE)
     out = tmp_path / "out"
     code = "from adhesive_contact_cli.main import main; main()"
@@ -50,11 +56,12 @@ def test_ctrl_c_stops_at_the_end_of_a_step_and_keeps_the_levels_done(tmp_path):
     reader.start()
     assert started.wait(60), "".join(lines)   # the progress bar is shown: the loop runs
     time.sleep(0.5)
-    proc.send_signal(signal.SIGINT)
-    assert proc.wait(60) == 130, "".join(lines)
+    proc.send_signal(sig)
+    returned = proc.wait(60)
+    assert returned == exit_code, (returned, "".join(lines))
     reader.join(5)
     errors = [line for line in lines if line.startswith("error: ")]
-    assert len(errors) == 1 and "interrupted after step" in errors[0], "".join(lines)
+    assert len(errors) == 1 and said in errors[0], "".join(lines)
     assert "Traceback" not in "".join(lines)
     run = json.loads((out / "summary.json").read_text())["run"]
     assert run["status"] == "interrupted" and run["partial"] and not run["success"]

@@ -9,12 +9,28 @@ manufactured solution, of a level) writes the point it found.
 import numpy as np
 
 
+#: the longest key or listed name a message shows whole; a longer one is
+#: cut in the middle (a 10,000-character unknown key made a line as long)
+SHOWN_KEY = 80
+
+
+def shown_key(key):
+    """``key`` as a message shows it: whole up to SHOWN_KEY characters, else
+    its start and end around "…"."""
+    key = str(key)
+    if len(key) <= SHOWN_KEY:
+        return key
+    half = (SHOWN_KEY - 1) // 2
+    return f"{key[:half]}…{key[-half:]}"
+
+
 class SceneError(ValueError):
-    """A scene that cannot be run; ``str(err)`` is ``"key: what is allowed"``."""
+    """A scene that cannot be run; ``str(err)`` is ``"key: what is allowed"``
+    (a long key cut to SHOWN_KEY characters; ``key`` keeps it whole)."""
 
     def __init__(self, key, message):
         self.key = key
-        super().__init__(f"{key}: {message}" if key else message)
+        super().__init__(f"{shown_key(key)}: {message}" if key else message)
 
 
 def where(points, index=None, t=None, digits=6):

@@ -125,6 +125,8 @@ MAX_CELL_ASPECT = 1e3       # longest over shortest edge of the structured cells
 MAX_NODES = 10**8           # nodes of the refined mesh
 MAX_UNIT = 16               # characters of a unit name in output.units
 MAX_MODULUS = 1e100         # |λ|, μ of a tensor (and of the sums of a memory kernel)
+MIN_MODULUS = 1e-100        # μ of an elastic tensor, and the bulk modulus λ + 2μ/d
+MIN_STEP = 1e-100           # k = T/N: the time levels n k keep their precision
 MAX_HALVINGS = 20           # k_min ≥ k_max 2^-20 (time.adaptive.k_min)
 
 _DECLARATIONS = (

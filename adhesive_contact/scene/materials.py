@@ -2,7 +2,7 @@
 by a Young or a Lamé pair, and the memory kernels built of them."""
 
 from .errors import SceneError
-from .keys import MAX_MODULUS
+from .keys import MAX_MODULUS, MIN_MODULUS
 from .reader import Table
 from .spec import Isotropic, MemorySpec, PronyTerm
 
@@ -39,8 +39,20 @@ def _isotropic(table, dim):
     return Isotropic(lam, mu, E, nu)
 
 
+def check_elastic(key, tensor, dim, what="the elastic tensor"):
+    """Refuse an elastic tensor whose μ or bulk modulus λ + 2μ/d is below
+    MIN_MODULUS: its stiffness matrix underflows (E = 5e-324 gave a
+    singular factorisation in the first step)."""
+    bulk = tensor.lam + 2.0 * tensor.mu / dim
+    if not (tensor.mu >= MIN_MODULUS and bulk >= MIN_MODULUS):
+        raise SceneError(key, f"gives {what} mu = {tensor.mu:.3g}, bulk modulus "
+                         f"{bulk:.3g}, below {MIN_MODULUS:g}, where the stiffness matrix "
+                         "underflows; give the moduli in other units (e.g. Pa or kPa)")
+
+
 def read_material(table, dim):
     material = _isotropic(table, dim)
+    check_elastic(table.key("E" if material.E is not None else "mu"), material, dim)
     table.finish()
     return material
 

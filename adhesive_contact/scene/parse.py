@@ -18,7 +18,8 @@ from pathlib import Path
 from .contact import read_contact
 from .errors import SceneError
 from .keys import MAX_TITLE, declared
-from .materials import check_relaxation_step, instantaneous, read_material, read_memory
+from .materials import (check_elastic, check_relaxation_step, instantaneous, read_material,
+                        read_memory)
 from .reader import Table
 from .spec import Scene
 from .tables import (check_something_holds, read_boundary, read_exact, read_loads, read_mesh, read_output,
@@ -47,6 +48,8 @@ def scene_from_dict(data, base_dir=None):
                              "\"relaxation\") gives the material; remove [material]")
         top.used.add("material")
         material = instantaneous(memory)
+        check_elastic("memory.long_term", memory.long_term, dim,
+                      "the long-term tensor of the relaxation kernel")
     else:
         material = read_material(top.table("material"), dim)
     body, traction = read_loads(top.table("loads"), dim, dirichlet, contact_sides, by_file)

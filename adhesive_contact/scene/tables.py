@@ -13,7 +13,7 @@ from ..fem.meshes.builtin import SIDES, nodes_of
 from ..linear_solvers.pardiso import available as pardiso_available
 from ..verification.manufactured import symbolic_problem
 from .errors import SceneError
-from .keys import MAX_CELL_ASPECT, MAX_HALVINGS, MAX_NODES, MAX_UNIT, declared, keys_in
+from .keys import MAX_CELL_ASPECT, MAX_HALVINGS, MAX_NODES, MAX_UNIT, MIN_STEP, declared, keys_in
 from .reader import coordinates, expression, show, vector_of_expressions
 from .spec import AdaptiveSpec, ExactSpec, MeshSpec, SolverSpec
 
@@ -237,6 +237,10 @@ def read_time(table):
     ``[time.adaptive]``, or None."""
     T = table.read("T")
     steps = table.read("steps")
+    if not T / steps >= MIN_STEP:
+        raise SceneError(table.key("T"), f"gives the time step k = T/steps = {T / steps:.3g}, "
+                         f"below {MIN_STEP:g}, where the time levels n k lose their "
+                         "precision; give the time in other units (e.g. ms or µs)")
     scheme = table.read("scheme")
     sub = table.table("adaptive")
     adaptive = None if sub is None else read_adaptive(sub, T / steps)
