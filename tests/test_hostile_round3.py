@@ -133,3 +133,22 @@ def test_adaptive_steps_from_one_uniform_step(tmp_path):
     assert sweep.exit_code == 0, sweep.stderr
     rows = (tmp_path / "sw" / "runs.csv").read_text().splitlines()
     assert len(rows) == 3 and all(",ok," in row for row in rows[1:])
+
+
+@pytest.mark.parametrize("strength, toughness, needle", [
+    (1e200, 1.0, "initial stiffness about 1e401 = e^2 strength^2 / toughness, beyond 1e100"),
+    (1e160, 1e-10, "initial stiffness about 1e331"),
+])
+def test_an_exponential_cohesive_law_whose_stiffness_overflows_is_refused(tmp_path, strength,
+                                                                          toughness, needle):
+    """The derived stiffness e² σ²/G was never range-checked: OverflowError."""
+    data = scene_dict({
+        "boundary": {"dirichlet": [], "contact": ["bottom"],
+                     "displacement": {"top": ["0", "0.01*t"]}},
+        "contact": {"normal": law("cohesive", shape="exponential", strength=strength,
+                                  toughness=toughness),
+                    "bonding": {"law": "cohesive"}}}, BASE)
+    del data["loads"]
+    (tmp_path / "s.toml").write_text(to_toml(data))
+    assert_one_line_error(invoke("check", tmp_path / "s.toml"), 2,
+                          "contact.normal.strength: gives the " + needle)

@@ -34,6 +34,7 @@ so the glue stores β K δ_n²/2 and a fall of β at fixed opening dissipates
 G_c (tests/test_cohesive.py).
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,6 +42,9 @@ import numpy as np
 #: openings beyond CUTOFF δ_c count as broken for the exponential shape
 CUTOFF = 20.0
 SHAPES = ("bilinear", "exponential")
+#: the largest initial stiffness K (as log10) a cohesive law may have: the
+#: step matrix adds K times the facets' measure to the body's stiffness
+MAX_STIFFNESS_LOG10 = 100
 
 
 @dataclass(frozen=True)
@@ -82,6 +86,16 @@ class CohesiveNormal:
             other = "mixity" if given == "toughness_shear" else "toughness_shear"
             return other, f"is required with {given} (the mixed-mode criterion needs both)"
         sigma, G = params["strength"], params["toughness"]
+        # the initial stiffness in logarithms: e² σ²/G overflowed (strength 1e200,
+        # or 1e160 with toughness 1e-10: OverflowError in every command)
+        log_K = (math.log10(K) if shape == "bilinear"
+                 else 2.0 * (math.log10(math.e) + math.log10(sigma)) - math.log10(G))
+        if log_K > MAX_STIFFNESS_LOG10:
+            return ("stiffness" if shape == "bilinear" else "strength"), (
+                f"gives the initial stiffness about 1e{round(log_K)}"
+                          + ("" if shape == "bilinear" else " = e^2 strength^2 / toughness")
+                          + f", beyond 1e{MAX_STIFFNESS_LOG10}, where the step matrix "
+                          "overflows; give the law in other units")
         if shape == "bilinear" and not 2.0 * G * K > sigma * sigma:
             return "toughness", (f"must exceed strength^2/(2 stiffness) = "
                                  f"{sigma * sigma / (2 * K):.4g} so that the softening "
