@@ -93,9 +93,9 @@ class CohesiveNormal:
         if log_K > MAX_STIFFNESS_LOG10:
             return ("stiffness" if shape == "bilinear" else "strength"), (
                 f"gives the initial stiffness about 1e{round(log_K)}"
-                          + ("" if shape == "bilinear" else " = e^2 strength^2 / toughness")
-                          + f", beyond 1e{MAX_STIFFNESS_LOG10}, where the step matrix "
-                          "overflows; give the law in other units")
+                + ("" if shape == "bilinear" else " = e^2 strength^2 / toughness")
+                + f", beyond 1e{MAX_STIFFNESS_LOG10}, where the step matrix overflows; "
+                "give the law in other units")
         if shape == "bilinear" and not 2.0 * G * K > sigma * sigma:
             return "toughness", (f"must exceed strength^2/(2 stiffness) = "
                                  f"{sigma * sigma / (2 * K):.4g} so that the softening "
