@@ -119,10 +119,10 @@ def test_a_reference_without_quantities_is_recomputed(study, scene_file, tmp_pat
 def test_another_quantity_is_another_study(study, scene_file, tmp_path):
     out = tmp_path / "out"
     shutil.copytree(study.out, out)
-    result = run(scene_file, "--param", "h", "--levels", 3, "--quantity", "work_T",
+    result = run(scene_file, "--param", "h", "--levels", 3, "--quantity", "normal_force_T",
                  "--out", out)
-    assert_one_line_error(result, 2, "quantity 'reaction_top_y_peak' there, 'work_T' here",
-                          alone=False)
+    assert_one_line_error(result, 2, "quantity 'reaction_top_y_peak' there, 'normal_force_T' "
+                          "here", alone=False)
 
 
 def test_bad_name_exits_2_listing_the_allowed_names(scene_file, tmp_path):
@@ -130,9 +130,11 @@ def test_bad_name_exits_2_listing_the_allowed_names(scene_file, tmp_path):
     result = run(scene_file, "--param", "h", "--levels", 3, "--quantity", "peak_force",
                  "--out", out)
     assert_one_line_error(result, 2, "--quantity: no quantity 'peak_force' in this scene; "
-                          "allowed: reaction_top_x_peak, reaction_top_x_T, "
-                          "reaction_top_y_peak", alone=False)
-    assert "debonding_T" in result.stderr and not out.exists()
+                          "allowed: beta_min_T, beta_mean_T, max_un_minus_g", alone=False)
+    for name in ("normal_force_T", "reaction_top_x_peak, reaction_top_x_T, reaction_top_y_peak",
+                 "debonding_T"):
+        assert name in result.stderr
+    assert not out.exists()
 
 
 def test_exact_reference_with_a_quantity_exits_2(tmp_path):

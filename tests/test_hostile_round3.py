@@ -152,3 +152,36 @@ def test_an_exponential_cohesive_law_whose_stiffness_overflows_is_refused(tmp_pa
     (tmp_path / "s.toml").write_text(to_toml(data))
     assert_one_line_error(invoke("check", tmp_path / "s.toml"), 2,
                           "contact.normal.strength: gives the " + needle)
+
+
+def test_converge_quantity_reads_every_number_of_a_sweep_row_and_refuses_one_with_no_value(
+        tmp_path):
+    """`--quantity normal_force_T` was refused though documented (any column
+    of a sweep's runs.csv); `--quantity work_T` on a scene without an energy
+    balance exited 0 with the quantity null on every level."""
+    import json
+
+    (tmp_path / "s.toml").write_text(to_toml(BASE))
+    result = invoke("converge", tmp_path / "s.toml", "--param", "h", "--levels", "2",
+                    "--reference", "fine", "--quantity", "normal_force_T", "--out",
+                    tmp_path / "o")
+    assert result.exit_code == 0, result.stderr
+    rows = json.loads((tmp_path / "o" / "rates.json").read_text())
+    assert rows["quantity"]["name"] == "normal_force_T"
+    # the body's weight, 10 × its area 1, is carried by the clamped top and Γ_C
+    # together: the same reference's top reaction and normal force add up to it
+    reaction = invoke("converge", tmp_path / "s.toml", "--param", "h", "--levels", "2",
+                      "--reference", "fine", "--quantity", "reaction_top_y_T", "--out",
+                      tmp_path / "r")
+    assert reaction.exit_code == 0, reaction.stderr
+    top = json.loads((tmp_path / "r" / "rates.json").read_text())["quantity"]["reference"]
+    assert 0.0 < rows["quantity"]["reference"] < 10.0
+    assert rows["quantity"]["reference"] + top == pytest.approx(10.0, rel=1e-9)
+    grown = scene_dict({"memory": {"kernel": "prony",
+                                   "terms": [{"E": 100.0, "nu": 0.3, "tau": 1.0}]}}, BASE)
+    (tmp_path / "g.toml").write_text(to_toml(grown))
+    assert_one_line_error(invoke("converge", tmp_path / "g.toml", "--param", "h", "--levels",
+                                 "2", "--quantity", "work_T", "--out", tmp_path / "g"), 2,
+                          "--quantity: 'work_T' has no value in this scene: the run has no "
+                          "energy balance")
+    assert not (tmp_path / "g").exists()

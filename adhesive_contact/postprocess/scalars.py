@@ -1,6 +1,14 @@
-"""The scalar quantities of a run that a study reports: per held side the
-peak and final reaction of each held component, the energies at T and the
-debonded area at T (docs/outputs.md, ``runs.csv``).
+"""The scalar quantities of a run that a study reports: the state of Γ_C
+at T, per held side the peak and final reaction of each held component,
+the energies at T and the debonded area at T (docs/outputs.md,
+``runs.csv``); a sweep's row and a convergence study's ``--quantity`` read
+the same names.
+
+State at T (:func:`state_quantities`): ``beta_min_T``, ``beta_mean_T``
+(None without contact facets), ``max_un_minus_g`` (over every level and
+contact node; None without a wall), the contact-node counts
+``separated_T``, ``on_wall_T``, ``compliance_T``, ``stick_T``, ``slip_T``
+(None without friction) and ``normal_force_T`` (positive in compression).
 
 Names: ``reaction_<side>_<x|y|z>_peak`` (the value of largest magnitude
 over the levels, with its sign) and ``reaction_<side>_<x|y|z>_T``;
@@ -12,14 +20,38 @@ balance, :mod:`.energy`); ``debonded_area_T``, ``damage_T`` and
 
 import numpy as np
 
-from .energy import energies
+from .energy import energies, energy_unavailable
 from .fracture import debonded_area, energy_per_area
+from .quantities import beta_mean
 from .reactions import reaction_sides, reactions
+from .states import contact_state_counts
 
 AXES = "xyz"
 ENERGY_NAMES = ("work_T", "stored_T", "dissipated_T", "viscous_T", "debonding_T",
                 "numerical_T", "balance_T")
 DEBONDING_NAMES = ("debonded_area_T", "damage_T", "glue_energy_per_area_T")
+STATE_NAMES = ("beta_min_T", "beta_mean_T", "max_un_minus_g", "separated_T", "on_wall_T",
+               "compliance_T", "stick_T", "slip_T", "normal_force_T")
+
+
+def state_quantities(solution):
+    """{name: value or None} of the state of Γ_C at T (module docstring)."""
+    states = {key: counts[-1] for key, counts in contact_state_counts(solution).items()}
+    mean = beta_mean(solution)
+    out = {"beta_min_T": float(solution.beta[-1].min()) if solution.beta.shape[1] else None,
+           "beta_mean_T": None if mean is None else float(mean[-1]),
+           "max_un_minus_g": _number(solution.gap_violation().max())}
+    out.update({f"{key}_T": _number(states.get(key))
+                for key in ("separated", "on_wall", "compliance", "stick", "slip")})
+    out["normal_force_T"] = float(solution.total_normal_force()[-1])
+    return out
+
+
+def _number(value):
+    if value is None:
+        return None
+    value = value.item() if hasattr(value, "item") else value
+    return value if isinstance(value, int) else float(value)
 
 
 def reaction_names(problem):
@@ -65,6 +97,31 @@ def scalar_quantities(solution):
 
 
 def quantity_names(problem):
-    """Every name :func:`scalar_quantities` gives for a run of ``problem``, in
-    its order (a value may still be None: no energy balance, no facets)."""
-    return [*reaction_names(problem), *ENERGY_NAMES, *DEBONDING_NAMES]
+    """Every name a study may converge for a run of ``problem``: those of
+    :func:`state_quantities` and :func:`scalar_quantities`, in order (a
+    value may still be None: no energy balance, no facets, no wall)."""
+    return [*STATE_NAMES, *reaction_names(problem), *ENERGY_NAMES, *DEBONDING_NAMES]
+
+
+def quantity_unavailable(problem, name):
+    """Why quantity ``name`` of :func:`quantity_names` has no value in a run of
+    ``problem`` (a sentence), or None when it has one."""
+    boundary = problem.boundary
+    facets = boundary is not None and boundary.facets.size > 0
+    energy = energy_unavailable(problem) if name in ENERGY_NAMES + (
+        "glue_energy_per_area_T",) else None
+    if energy is not None:
+        return f"the run has no energy balance: {energy}"
+    if not facets and (name in DEBONDING_NAMES or name.startswith("beta_")):
+        return "the scene has no contact facets"
+    if name == "max_un_minus_g" and problem.gap is None:
+        return "the scene has no wall (no contact.gap or [contact.foundation])"
+    if name in ("stick_T", "slip_T") and problem.friction is None:
+        return "the scene has no friction law"
+    return None
+
+
+def study_quantities(solution):
+    """:func:`state_quantities` and :func:`scalar_quantities` in one dict:
+    what a convergence study measures of each run."""
+    return state_quantities(solution) | scalar_quantities(solution)

@@ -42,7 +42,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..postprocess.scalars import quantity_names, scalar_quantities
+from ..postprocess.scalars import quantity_names, quantity_unavailable, study_quantities
 from ..problem.build import build_problem
 from ..verification.rates import pairwise_rates, rates
 from ..verification.levels import (
@@ -268,7 +268,7 @@ def _setup(source, base, param, levels, ref_h, ref_k, reference):
 
 def _compute_level(state, level):
     return run_level(state.scene, state.param, level, state.reference,
-                     measure=scalar_quantities)
+                     measure=study_quantities)
 
 
 # ---------------------------------------------------------------- the study
@@ -371,6 +371,10 @@ class ConvergenceStudy(Study):
             if quantity not in allowed:
                 raise StudyError("quantity", f"no quantity {quantity!r} in this scene; "
                                  f"allowed: {', '.join(allowed)}")
+            missing = quantity_unavailable(build_problem(self.scene), quantity)
+            if missing is not None:
+                raise StudyError("quantity", f"{quantity!r} has no value in this scene: "
+                                 f"{missing}")
             if reference == "exact":
                 raise StudyError("quantity", f"{quantity!r} is not computable from the "
                                  "scene's [exact] solution (it gives u and β, not reactions "
@@ -463,7 +467,7 @@ class ConvergenceStudy(Study):
         def compute(state, key):
             return run_reference(self.scene, self.param, self.levels, self.ref_h, self.ref_k,
                                  progress=lambda n, N: progress("reference", n + 1, total),
-                                 measure=scalar_quantities)
+                                 measure=study_quantities)
 
         _, fine, message = attempt(compute, None, "reference")
         if message is not None:

@@ -42,9 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import SceneError, build_problem, scene_from_dict, solve
-from ..postprocess.quantities import beta_mean
-from ..postprocess.scalars import scalar_quantities
-from ..postprocess.states import contact_state_counts
+from ..postprocess.scalars import scalar_quantities, state_quantities
 from ..problem.warnings import solution_warnings
 from ..storage import plain, toml_value, write_atomic
 from .study import Study, StudyError, scene_identity, scene_source
@@ -250,10 +248,6 @@ def peak_rss_mib():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def _at_T(values):
-    return None if values is None else values[-1]
-
-
 def run_variant(document, values, base_dir=None):
     """Build and solve one variant; its record (plain JSON). A relative
     ``mesh.file`` is taken in ``base_dir`` (the scene file's folder).
@@ -294,18 +288,11 @@ def run_variant(document, values, base_dir=None):
             "failure": {"step": failure.n, "t": failure.t, "residual": result.residual,
                         "iterations": result.nit, "message": str(failure)},
             "residual": result.residual})
-    states = {key: counts[-1] for key, counts in contact_state_counts(solution).items()}
-    has_beta = solution.beta.shape[1] > 0
     return plain(record | {
         "outcome": "ok", "failure": None,
         "residual": solution.residual.max(),
         "newton_total": solution.iterations.sum(), "newton_max": solution.iterations.max(),
-        "beta_min_T": solution.beta[-1].min() if has_beta else None,
-        "beta_mean_T": _at_T(beta_mean(solution)),
-        "max_un_minus_g": solution.gap_violation().max(),
-        **{f"{key}_T": states.get(key) for key in ("separated", "on_wall", "compliance",
-                                                  "stick", "slip")},
-        "normal_force_T": solution.total_normal_force()[-1],
+        **state_quantities(solution),
         "quantities": scalar_quantities(solution),
         "warnings": solution_warnings(solution)})
 
