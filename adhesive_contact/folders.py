@@ -34,6 +34,8 @@ involved.
 
 import contextlib
 import os
+import re
+import stat
 import shutil
 import tempfile
 from pathlib import Path
@@ -57,6 +59,17 @@ class FolderLocked(OSError):
         owner = "another process" if pid is None else f"another process (pid {pid})"
         super().__init__(f"{str(self.folder)!r} is being written by {owner}; its lock is "
                          f"{str(self.lock_path)!r}")
+
+
+class ForeignLockFile(OSError):
+    """The lock file's name is taken by something that is no lock of ours (a
+    user's own file, a folder, a link): it is never truncated nor removed."""
+
+    def __init__(self, lock_path):
+        self.lock_path = Path(lock_path)
+        super().__init__(f"{str(self.lock_path)!r} exists and is not a lock of adhcontact "
+                         "(a lock holds one process id): it is left as it is; move it, or "
+                         "use another --out")
 
 
 class PublishError(OSError):
@@ -148,7 +161,15 @@ def _lock_file(path):
     except ImportError:   # pragma: no cover - not POSIX
         return _lock_file_exclusive(path)
     while True:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:   # never through a link, never a folder or a device
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+        except OSError as err:
+            if os.path.lexists(path) and not stat.S_ISREG(os.lstat(path).st_mode):
+                raise ForeignLockFile(path) from None
+            raise err
+        if not _ours(fd):
+            os.close(fd)
+            raise ForeignLockFile(path)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -166,6 +187,16 @@ def _lock_file(path):
             os.write(fd, f"{os.getpid()}\n".encode("ascii"))
             return fd
         os.close(fd)
+
+
+def _ours(fd):
+    """Whether the open file ``fd`` can be a lock file of ours: a regular
+    file that is empty (created, not yet written) or holds one pid line."""
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode) or info.st_size > 32:
+        return False
+    text = os.pread(fd, 33, 0)
+    return text == b"" or re.fullmatch(rb"[0-9]+\n?", text) is not None
 
 
 def _lock_file_exclusive(path):   # pragma: no cover - not POSIX

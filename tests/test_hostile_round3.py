@@ -185,3 +185,31 @@ def test_converge_quantity_reads_every_number_of_a_sweep_row_and_refuses_one_wit
                           "--quantity: 'work_T' has no value in this scene: the run has no "
                           "energy balance")
     assert not (tmp_path / "g").exists()
+
+
+@pytest.mark.parametrize("command", [["solve"], ["sweep", "--set", "time.steps=1,2"]],
+                         ids=lambda c: c[0])
+@pytest.mark.parametrize("kind", ["file", "link", "folder"])
+def test_a_users_file_named_like_the_lock_is_never_touched(tmp_path, command, kind):
+    """A user's own file named `.DIR.lock` beside --out was truncated and
+    deleted by the run; a link of that name had its target truncated."""
+    (tmp_path / "s.toml").write_text(to_toml(BASE))
+    lock = tmp_path / ".out.lock"
+    target = tmp_path / "notes.txt"
+    target.write_text("my notes\n")
+    if kind == "file":
+        lock.write_text("my notes\n")
+    elif kind == "link":
+        lock.symlink_to(target)
+    else:
+        lock.mkdir()
+        (lock / "inside.txt").write_text("mine\n")
+    result = invoke(command[0], tmp_path / "s.toml", *command[1:], "--out", tmp_path / "out")
+    assert_one_line_error(result, 2, "exists and is not a lock of adhcontact", alone=False)
+    assert target.read_text() == "my notes\n"
+    assert lock.is_symlink() if kind == "link" else lock.exists()
+    if kind == "file":
+        assert lock.read_text() == "my notes\n"
+    if kind == "folder":
+        assert (lock / "inside.txt").read_text() == "mine\n"
+    assert not (tmp_path / "out").exists()
