@@ -213,3 +213,21 @@ def test_a_users_file_named_like_the_lock_is_never_touched(tmp_path, command, ki
     if kind == "folder":
         assert (lock / "inside.txt").read_text() == "mine\n"
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("foundation, needle", [
+    ({"shape": "sphere", "point": [1.0, -1e17], "radius": 1e17},
+     "contact.foundation.radius: is 1e+17, more than 1e+06 times the body's diameter"),
+    ({"shape": "sphere", "point": [1.1, 0.3], "radius": 0.02},    # between the nodes
+     "contact.foundation.point: (1.1, 0.3) lies inside the body"),
+    ({"shape": "sphere", "point": [1.0, 0.6], "radius": 0.3},
+     "contact.foundation: the mesh node (0.75, 0.5) lies inside the foundation"),
+])
+def test_a_foundation_in_the_body_or_too_flat_to_measure_is_refused(tmp_path, foundation,
+                                                                     needle):
+    """A sphere of radius 1e17 (its distance lost to round-off) and a disc
+    inside the body were accepted; the body's contact nodes, which alone
+    were checked, lie outside both."""
+    data = scene_dict({"contact.foundation": foundation}, BASE)
+    (tmp_path / "s.toml").write_text(to_toml(data))
+    assert_one_line_error(invoke("check", tmp_path / "s.toml"), 2, needle)

@@ -38,7 +38,7 @@ from ..fem.contact_boundary import (
     tangent_frame,
 )
 from ..fem.dirichlet import prescribed_displacement, rigid_modes
-from ..fem.foundation import foundation_gap, foundation_normal
+from ..fem.foundation import foundation_gap, foundation_normal, signed_distance
 from ..fem.meshes import build_mesh, named_facets
 from ..laws import make_bonding, make_friction, make_normal_law
 from ..scene import SceneError
@@ -50,6 +50,7 @@ from .checks import (
     check_gap,
     check_kernel,
     check_loads,
+    check_foundation_beside_body,
     check_outside_foundation,
     check_prescribed,
     check_probes,
@@ -256,6 +257,7 @@ def gap_at_nodes(scene, mesh, boundary, times):
         nu = boundary.frame[:, :, 0].T
         along, depth = foundation_gap(scene.contact.foundation, x, nu)
         check_outside_foundation(x, depth)
+        check_foundation_beside_body(scene.contact.foundation, mesh, signed_distance)
         own = np.all(nu == foundation_normal(scene.contact.foundation, x)[0], axis=0)
         g = np.where(own, np.maximum(depth, 0.0), along)
         if scene.adaptive is not None:   # N 2^J rows of one: a read-only view

@@ -441,6 +441,47 @@ def check_outside_foundation(x, depth):
                          "the foundation; the body must start outside it")
 
 
+#: the largest sphere or cylinder radius over the body's diameter: its
+#: distance |x − c| − r loses about r·1e-16 to round-off, which must stay
+#: far below the contact states' tolerance of 1e-8 of the diameter
+MAX_FOUNDATION_RADIUS = 1e6
+
+
+def check_foundation_beside_body(spec, mesh, signed_distance):
+    """The foundation ``spec`` lies beside the body, not in it: no node of
+    the mesh inside it, and a sphere's or cylinder's centre point not inside
+    a cell; its radius at most MAX_FOUNDATION_RADIUS diameters of the body
+    (a sphere of radius 1e17 and a disc inside the body were accepted)."""
+    p = mesh.p
+    diameter = float(np.linalg.norm(p.max(axis=1) - p.min(axis=1)))
+    if spec.shape != "plane" and spec.radius > MAX_FOUNDATION_RADIUS * diameter:
+        raise SceneError("contact.foundation.radius", f"is {spec.radius:g}, more than "
+                         f"{MAX_FOUNDATION_RADIUS:g} times the body's diameter {diameter:g}, "
+                         "where the distance to it is lost to round-off; use shape = "
+                         "\"plane\" for so flat a foundation")
+    depth = signed_distance(spec, p)
+    inside = depth < -1e-12 * (1.0 + np.abs(p).max())
+    if inside.any():
+        a = int(np.argmax(inside))
+        raise SceneError("contact.foundation", f"the mesh node {where(p, a)} lies inside the "
+                         "foundation; the body must start outside it")
+    if spec.shape != "plane" and _in_a_cell(mesh, np.asarray(spec.point, dtype=float)):
+        raise SceneError("contact.foundation.point", f"{where(np.asarray(spec.point))} lies "
+                         "inside the body: the foundation must lie beside it, outside it")
+
+
+def _in_a_cell(mesh, point):
+    """Whether ``point`` (d,) lies in a simplex of ``mesh`` (barycentric
+    coordinates ≥ 0 in one cell; vectorised over the cells)."""
+    v = mesh.p[:, mesh.t]                           # (d, d+1, ncells)
+    edges = v[:, 1:, :] - v[:, :1, :]                # (d, d, ncells)
+    rhs = point[:, None] - v[:, 0, :]                # (d, ncells)
+    with np.errstate(all="ignore"):
+        lam = np.linalg.solve(np.moveaxis(edges, -1, 0), rhs.T[:, :, None])[:, :, 0]
+    tol = 1e-12
+    return bool(np.any((lam >= -tol).all(axis=1) & (lam.sum(axis=1) <= 1.0 + tol)))
+
+
 def check_beta0(beta0):
     """β_0^h in [0, 1] on every contact facet."""
     if not np.all((beta0 >= 0) & (beta0 <= 1)):
