@@ -231,3 +231,32 @@ def test_a_foundation_in_the_body_or_too_flat_to_measure_is_refused(tmp_path, fo
     data = scene_dict({"contact.foundation": foundation}, BASE)
     (tmp_path / "s.toml").write_text(to_toml(data))
     assert_one_line_error(invoke("check", tmp_path / "s.toml"), 2, needle)
+
+
+COHESIVE = scene_dict({
+    "boundary": {"dirichlet": [], "contact": ["bottom"],
+                 "displacement": {"top": ["0", "0.001*t"]}},
+    "contact": {"normal": law("cohesive", shape="bilinear", strength=1.0, toughness=0.01,
+                              stiffness=1000.0),
+                "bonding": {"law": "cohesive"}}}, BASE)
+del COHESIVE["loads"]
+
+
+def test_a_sweep_grid_with_one_invalid_combination_runs_it_as_a_failed_row(tmp_path):
+    """strength 2 with stiffness 60 breaks 2 G K > σ² (4 > 1.2), each valid
+    alone: the grid was refused whole, as the variant checked for strength
+    = 2 was that combination; the docs promise a failed row. A value that
+    is invalid alone on the scene is still refused before anything runs."""
+    (tmp_path / "s.toml").write_text(to_toml(COHESIVE))
+    result = invoke("sweep", tmp_path / "s.toml", "--set", "contact.normal.strength=1,2",
+                    "--set", "contact.normal.stiffness=60,1000", "--out", tmp_path / "o")
+    assert result.exit_code == 0, result.stderr
+    rows = [row.split(",") for row in (tmp_path / "o" / "runs.csv").read_text().splitlines()]
+    outcome = {(r[1], r[2]): r[3] for r in rows[1:]}
+    assert outcome == {("1", "60"): "ok", ("1", "1000"): "ok", ("2", "60"): "failed",
+                       ("2", "1000"): "ok"}
+    alone = invoke("sweep", tmp_path / "s.toml", "--set", "contact.normal.strength=1,100",
+                   "--out", tmp_path / "a")
+    assert_one_line_error(alone, 2, "--set contact.normal.strength=100: is not valid in this "
+                          "scene: contact.normal.toughness: must exceed", alone=False)
+    assert not (tmp_path / "a").exists()

@@ -434,7 +434,8 @@ class Sweep(Study):
         self.warnings = []
         for index in self.checked():
             problem = self._check(self.runs[index])
-            self.warnings += [(index, str(w)) for w in problem.warnings()]
+            if problem is not None:
+                self.warnings += [(index, str(w)) for w in problem.warnings()]
 
     def checked(self):
         """The indices of the variants checked before anything runs: in zip
@@ -448,8 +449,13 @@ class Sweep(Study):
         return sorted({j * stride for length, stride in zip(lengths, strides)
                        for j in range(length)})
 
-    def _check(self, values):
-        """The problem of one variant, or StudyError naming the setting at fault."""
+    def _check(self, values, alone=False):
+        """The problem of one variant, or StudyError naming the setting at
+        fault. A variant refused for a key it does not set is checked again
+        one value at a time, each alone on the base scene: a value that is
+        refused alone is the setting at fault; when each is valid alone the
+        combination is not a scene, which is a failed run, not an error
+        (None)."""
         document = self.source
         for key, value in values.items():
             try:
@@ -463,8 +469,12 @@ class Sweep(Study):
                 reason = str(err).removeprefix(f"{err.key}: ")
                 raise StudyError(f"set {err.key}={toml_value(values[err.key])}", reason) from None
             where = ", ".join(f"{k}={toml_value(v)}" for k, v in values.items())
-            raise StudyError("set", f"the variant {where} is not a valid scene: {err}") \
-                from None
+            if alone or len(values) == 1:
+                raise StudyError(f"set {where}", f"is not valid in this scene: {err}") \
+                    from None
+        for key, value in values.items():
+            self._check({key: value}, alone=True)
+        return None   # each value valid alone: the combination is a failed run
 
     def identity(self):
         identity = {"scene": scene_identity(self.base),
