@@ -260,3 +260,32 @@ def test_a_sweep_grid_with_one_invalid_combination_runs_it_as_a_failed_row(tmp_p
     assert_one_line_error(alone, 2, "--set contact.normal.strength=100: is not valid in this "
                           "scene: contact.normal.toughness: must exceed", alone=False)
     assert not (tmp_path / "a").exists()
+
+
+def test_adaptive_steps_that_cannot_keep_the_explicit_euler_bound_are_refused(tmp_path):
+    """γ_ν = 1e12 puts the explicit Euler bound at 1e-8, below any k_min: the
+    run went on at k_min until β left [0, 1] (the message named k = k_max
+    and asked for [time.adaptive], which the scene had). With a reachable
+    bound the message names the k_min that keeps it, and a run with it
+    keeps β in [0, 1]."""
+    import tomllib
+    from pathlib import Path
+
+    default = tomllib.loads((Path(__file__).resolve().parents[1] / "cli" /
+                             "default_scene.toml").read_text())
+    default["contact"]["bonding"]["gamma_nu"] = 1e12
+    default["time"]["adaptive"] = {"tol": 0.1}
+    (tmp_path / "s.toml").write_text(to_toml(default))
+    assert_one_line_error(invoke("check", tmp_path / "s.toml"), 2,
+                          "time.adaptive.k_min: the adaptive steps' smallest pair 2 k_min = "
+                          "4.883e-05 is beyond the explicit Euler bound k <= 1e-08")
+    default["contact"]["bonding"]["gamma_nu"] = 1e9   # bound 1e-5
+    default["time"].update(T=0.002, steps=2)
+    default["time"]["adaptive"]["k_min"] = 1e-5
+    (tmp_path / "s.toml").write_text(to_toml(default))
+    result = invoke("check", tmp_path / "s.toml")
+    assert_one_line_error(result, 2, "give time.adaptive.k_min <= 5e-06")
+    default["time"]["adaptive"]["k_min"] = 5e-6
+    (tmp_path / "s.toml").write_text(to_toml(default))
+    result = invoke("solve", tmp_path / "s.toml", "--out", tmp_path / "o", "-q")
+    assert result.exit_code == 0, result.stderr

@@ -50,6 +50,7 @@ from .checks import (
     check_gap,
     check_kernel,
     check_loads,
+    check_adaptive_bound,
     check_foundation_beside_body,
     check_outside_foundation,
     check_prescribed,
@@ -71,6 +72,7 @@ def build_problem(scene):
     if scene.memory is not None and scene.memory.kernel == "function":
         check_kernel("memory.r", scene.memory.function, times[1], times.size - 1)
     laws = contact_laws(scene)
+    check_adaptive_bound(scene, laws.bonding)
     exact = manufactured_solution(scene, mesh, laws, times, held)
     on_contact = contact(scene, mesh, assembly, held, laws, times)
     held_by_contact = restraint(scene, mesh, held, laws, on_contact)

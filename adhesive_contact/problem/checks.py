@@ -39,6 +39,7 @@ import numpy as np
 from ..expressions import coordinates
 from ..fem.dirichlet import rigid_modes
 from ..scene.errors import SceneError, where
+from ..scene.keys import MAX_HALVINGS
 
 #: time levels sampled besides t = 0 and t = T (where not every level is)
 TIME_SAMPLES = 16
@@ -134,6 +135,30 @@ def check_loads(keyed_fields, loads, times):
                 check_on_grid(key, field, points, times)
             else:
                 check_finite(key, field, points, sample_times(times))
+
+
+def check_adaptive_bound(scene, bonding):
+    """With [time.adaptive] and the explicit bonding integrator every step,
+    the doubled one included, is held below the explicit Euler bound k_E:
+    the smallest pair 2 k_min must be within it (γ = 1e12 ran at k_min far
+    beyond it until β left [0, 1])."""
+    if (scene.adaptive is None or bonding is None or scene.contact.integrator != "explicit"
+            or getattr(bonding, "rate_independent", False)):
+        return
+    bound = float(bonding.stable_step())
+    k_min = scene.adaptive.k_min
+    if 2.0 * k_min <= bound:
+        return
+    floor = scene.k * 2.0 ** -MAX_HALVINGS
+    fix = (f"give time.adaptive.k_min <= {0.5 * bound:.4g}" if 2.0 * floor <= bound else
+           f"no k_min reaches it (at least k_max 2^-{MAX_HALVINGS} = {floor:.4g}): use at "
+           f"least time.steps = {int(np.ceil(scene.T / (bound * 2.0 ** (MAX_HALVINGS - 1))))} "
+           f"with time.adaptive.k_min <= {0.5 * bound:.4g}")
+    raise SceneError("time.adaptive.k_min", f"the adaptive steps' smallest pair 2 k_min = "
+                     f"{2.0 * k_min:.4g} is beyond the explicit Euler bound k <= {bound:.4g} of "
+                     f"the bonding law, which every step must keep (beta leaves [0, 1] beyond "
+                     f"it); {fix}, or contact.bonding.integrator = 'implicit', "
+                     "'exponential' or 'midpoint'")
 
 
 def check_kernel(key, r, k, steps):

@@ -76,7 +76,7 @@ def check_level(problem, level):
             reason += (f". The explicit Euler step of the bonding law keeps beta in [0, 1] "
                        f"only for k (gamma_nu + gamma_tau) L^2 <= 1, i.e. k <= {bound:.4g}; "
                        f"this run has k = {k:.4g}")
-            if k > bound:
+            if k > bound and problem.scene.adaptive is None:
                 need = int(np.ceil(problem.scene.T / bound))
                 reason += (f". Use at least time.steps = {need} or [time.adaptive] tol; "
                            f"{BEYOND_TIME_SCALE} "
