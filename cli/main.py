@@ -109,6 +109,21 @@ def level_status(level):
 STOP_SIGNALS = {signal.SIGINT: 130, signal.SIGTERM: 143}
 
 
+def adaptive_pace(scene, folder, force):
+    """The :class:`~adhesive_contact.resources.PaceGuard` of an adaptive
+    run into ``folder`` (None for uniform steps or with ``--force``)."""
+    if scene.adaptive is None or force:
+        return None
+    from adhesive_contact.resources import PaceGuard, estimate
+
+    return PaceGuard(estimate(scene), scene.T, folder)
+
+
+def folder_bytes(folder):
+    """The bytes the files of ``folder`` hold (not its subfolders)."""
+    return sum(entry.stat().st_size for entry in os.scandir(folder) if entry.is_file())
+
+
 @contextlib.contextmanager
 def interruptible():
     """A block in which Ctrl-C (SIGINT) or SIGTERM (what a batch system
@@ -195,10 +210,20 @@ def solve_command(scene, out, force, quiet):
     base = scene_folder(scene)   # summary.json keeps the scene to rebuild the problem from
     source = {"text": text, "folder": None if base is None else str(base.resolve())}
 
-    files, failures, kept = [], [], False
+    files, failures, kept, paced = [], [], False, []
     try:
         with staged_output(out) as folder:
             recorder = StreamingRecorder(problem, folder)   # levels to disk as computed
+            pace = adaptive_pace(parsed, folder, force)
+
+            def progress(n, N):
+                bar.update(1, recorder.last)
+                if pace is not None and not paced:
+                    reason = pace.check(recorder.count, recorder.last.t,
+                                        lambda: folder_bytes(folder))
+                    if reason is not None:
+                        paced.append(reason)
+                return bool(interrupted()) or bool(paced)
             try:
                 with click.progressbar(length=parsed.steps + 1,
                                        file=io.StringIO() if quiet else sys.stderr,
@@ -206,9 +231,7 @@ def solve_command(scene, out, force, quiet):
                                               else f"{name}: {parsed.steps} steps"),
                                        item_show_func=lambda level: level_status(level)) \
                         as bar, interruptible() as interrupted:
-                    solution = solve(problem, recorder=recorder,
-                                     progress=lambda n, N: bar.update(1, recorder.last)
-                                     or bool(interrupted()))
+                    solution = solve(problem, recorder=recorder, progress=progress)
                     stopped_by = interrupted()
                 # a partial run never replaces a complete earlier one
                 kept = not solution.success and holds_complete_run(out)
@@ -231,6 +254,13 @@ def solve_command(scene, out, force, quiet):
     not_written = (f"the {solution.t.size} levels done were not written: {out}/ holds a "
                    "complete earlier run, which is kept (use another --out to keep a "
                    "partial run)")
+    if solution.status == STOPPED and paced and not stopped_by:
+        raise CliError(f"stopped after step {solution.steps} (t = {solution.t[-1]:g}): "
+                       f"{paced[0]}; "
+                       + (not_written if kept else
+                          f"the {solution.t.size} levels done were written to {out}/ "
+                          "(summary.json: run.partial = true)")
+                       + "; use a larger time.adaptive.tol or k_min, or --force to run on", 1)
     if solution.status == STOPPED:
         by = "" if stopped_by != signal.SIGTERM else " by SIGTERM"
         raise CliError(f"interrupted{by} after step {solution.steps} (t = {solution.t[-1]:g}); "

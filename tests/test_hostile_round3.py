@@ -289,3 +289,35 @@ def test_adaptive_steps_that_cannot_keep_the_explicit_euler_bound_are_refused(tm
     (tmp_path / "s.toml").write_text(to_toml(default))
     result = invoke("solve", tmp_path / "s.toml", "--out", tmp_path / "o", "-q")
     assert result.exit_code == 0, result.stderr
+
+
+def test_an_adaptive_run_past_its_estimate_stops_when_its_pace_outgrows_the_disk(
+        tmp_path, monkeypatch):
+    """The estimate of an adaptive run counted the uniform grid only (tol
+    1e-8: 9 levels estimated, 97,878 taken, 1.7 GB), so the guard could
+    never fire. Now the estimate gives both ends, and the run projects its
+    needs from its pace at every doubling past the estimate: here with 40 MB
+    free (the uniform grid's 3 MB fits) it stops at the first checkpoint,
+    writes the levels done and says what it would need."""
+    import json
+    import tomllib
+    from pathlib import Path
+
+    import adhesive_contact.resources as resources
+    from adhesive_contact import parse_scene
+
+    default = tomllib.loads((Path(__file__).resolve().parents[1] / "cli" /
+                             "default_scene.toml").read_text())
+    default["time"]["adaptive"] = {"tol": 0.001}
+    text = to_toml(default)
+    est = resources.estimate(parse_scene(text))
+    assert est.levels == 41 and est.levels_at_most == 40 * 1024 + 1
+    assert est.disk_bytes < 40e6 < est.disk_bytes_at_most
+    assert "at most 4.1e+04 levels" in est.describe()
+    (tmp_path / "s.toml").write_text(text)
+    monkeypatch.setattr(resources, "free_disk", lambda folder: 40e6)
+    result = invoke("solve", tmp_path / "s.toml", "--out", tmp_path / "o", "-q")
+    assert_one_line_error(result, 1, "the adaptive steps need about", alone=False)
+    assert "more than the 40 MB free" in result.stderr and "--force" in result.stderr
+    run = json.loads((tmp_path / "o" / "summary.json").read_text())["run"]
+    assert run["partial"] and 41 <= run["levels"] < 100
