@@ -72,7 +72,8 @@ def test_the_library_refuses_a_scene_path_that_is_no_regular_file(tmp_path):
 
 # ---------------------------------------------------------------- values past what the numbers hold
 
-from conftest import assert_one_line_error, invoke, law, scene_dict, to_toml  # noqa: E402
+from conftest import assert_one_line_error, invoke, law, run, scene_dict, to_toml  # noqa: E402
+import numpy as np  # noqa: E402
 
 BASE = scene_dict({"contact.normal": law("compliance", c=1e4),
                    "loads": {"body": ["0", "-10*t"]}, "time.steps": 2})
@@ -321,3 +322,31 @@ def test_an_adaptive_run_past_its_estimate_stops_when_its_pace_outgrows_the_disk
     assert "more than the 40 MB free" in result.stderr and "--force" in result.stderr
     run = json.loads((tmp_path / "o" / "summary.json").read_text())["run"]
     assert run["partial"] and 41 <= run["levels"] < 100
+
+
+def test_coulomb_on_a_body_held_by_contact_alone_engages_from_zero_load():
+    """A block on a compliant layer, held by nothing but Γ_C, pressed by 10 t
+    and sheared by 1 t on its top (shear/normal 0.1 < μ = 0.5): it failed at
+    step 1 ("a load they cannot balance"), the Coulomb bound being frozen at
+    the zero pressure of t = 0 first. Now it holds, and at every level the
+    nodal forces meet Coulomb's conditions by hand: |F_τ,a| ≤ μ p_a w_a,
+    stuck nodes inside the cone, and the totals balance the loads."""
+    from adhesive_contact.postprocess import total_contact_force
+
+    data = scene_dict({
+        "boundary": {"dirichlet": [], "contact": ["bottom"]},
+        "loads": {"traction": {"top": ["1*t", "-10*t"]}},
+        "contact": {"normal": law("compliance", c=1e4),
+                    "friction": [law("coulomb", mu=0.5)]},
+        "time.steps": 4}, BASE)
+    problem, solution = run(data)
+    assert solution.success, solution.message
+    F = total_contact_force(solution)
+    np.testing.assert_allclose(F, np.stack([-2.0 * solution.t, 20.0 * solution.t], axis=1),
+                               rtol=1e-8, atol=1e-9)
+    w = problem.boundary.node_weights
+    p = 1e4 * np.maximum(solution.frame_displacement[:, :, 0], 0.0)   # c u_ν+
+    bound = 0.5 * p * w
+    tangential = np.abs(solution.contact_force[:, :, 1])
+    assert np.all(tangential <= bound * (1 + 1e-8) + 1e-12)
+    assert np.abs(F[-1, 0]) > 0     # friction carries the shear

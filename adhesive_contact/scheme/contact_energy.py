@@ -89,6 +89,11 @@ class ContactEnergy:
         self.friction = self.friction_law.with_pressure(pressure)
         return pressure
 
+    def set_pressure_values(self, pressure):
+        """Freeze a Coulomb bound at the given pressure (nq,) from now on."""
+        if self.pressure_dependent:
+            self.friction = self.friction_law.with_pressure(np.asarray(pressure, dtype=float))
+
     def set_held(self, values):
         """Use the held values z_D from now on: ``values`` (nc·d,) the frame
         components of g_D(t_n) (:meth:`~adhesive_contact.fem.contact_boundary.ContactBoundary.held_values`),

@@ -147,7 +147,15 @@ class ContactStep:
         if before is not None and solver.method == "newton":
             z0 = self.predictor(S, c, upper, z0, before, n)
         S.indefinite, solves_before = False, S.indefinite_solves
-        result = minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
+        if (self.energy.pressure_dependent and self.problem.held_by_contact
+                and not np.any(self.kink.radius > 0)):
+            # no bound at the last level's pressure (sheared from zero load):
+            # the first solve would slide a body held by contact away
+            result = self.stuck_start(S, c, upper, options, z0, None)
+        else:
+            result = minimise(solver.method, S, c, self.energy, upper, z0, options, self.kink)
+            if self.energy.pressure_dependent and not result.success:
+                result = self.stuck_start(S, c, upper, options, z0, result)
         if self.energy.pressure_dependent and result.success:
             result = self.pressure_fixed_point(S, c, upper, options, result)
         result.indefinite = bool(S.indefinite and result.nit > 0)
@@ -165,6 +173,38 @@ class ContactStep:
             boundary = self.problem.boundary
             self.kink.radius = self.energy.node_kink(
                 boundary.point_node, boundary.nodes.size)[self.kink_nodes]
+
+    def stuck_start(self, S, c, upper, options, z0, failed):
+        """A Coulomb step whose bound, frozen at the last level's pressure,
+        holds too little (a body held by contact alone, sheared from zero
+        load: the bound is 0 at t = 0, so the first solve slides away) is
+        started again from Γ_C stuck: the bound frozen at a pressure so large
+        that no node slides, solved from ``z0``; its solution's pressure then
+        starts the fixed point (:meth:`pressure_fixed_point`). Returns that
+        solve's result, or ``failed`` (the first solve's result, or None
+        when there was none) when it fails too."""
+        scale = max(np.abs(c).max(initial=0.0), 1e-300)
+        w = self.energy.w
+        large = 1e6 * scale / max(float(w[w > 0].min(initial=1.0)), 1e-300)
+        mu = max(float(getattr(law, "mu", 0.0)) for law in self.energy.friction_law.laws)
+        self.energy.set_pressure_values(np.full(w.size, large / max(mu, 1e-300)))
+        self.set_radius()
+        stuck = minimise(self.problem.scene.solver.method, S, c, self.energy, upper, z0,
+                         options, self.kink)
+        before = 0 if failed is None else failed.nit
+        if not stuck.success:
+            self.energy.set_pressure(z0)
+            self.set_radius()
+            if failed is None:
+                stuck.nit += before
+                return stuck
+            return failed
+        self.energy.set_pressure(stuck.z)
+        self.set_radius()
+        result = minimise(self.problem.scene.solver.method, S, c, self.energy, upper, stuck.z,
+                          options, self.kink)
+        result.nit += before + stuck.nit
+        return result
 
     def pressure_fixed_point(self, S, c, upper, options, result):
         """A Coulomb bound's fixed point within the step (docs/model.md,
