@@ -64,6 +64,21 @@ def draw_to_files():
         os.environ["MPLBACKEND"] = "Agg"
 
 
+def end(code):
+    """Exit with ``code``. After an HDF5 file failed to close (a full disk)
+    the HDF5 library's own clean-up at exit crashes the process (a
+    segmentation fault or an abort, io/h5.py): the outputs are then already
+    removed and the message printed, so the process ends at once."""
+    from adhesive_contact.io.h5 import held_open
+
+    code = code if isinstance(code, int) else (0 if code is None else 1)
+    if held_open():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 class OneLineGroup(click.Group):
     """A click group whose errors (usage errors too) are one line on stderr."""
 
@@ -74,6 +89,12 @@ class OneLineGroup(click.Group):
         draw_to_files()
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, False, **extra)
+        try:
+            self._standalone(args, prog_name, complete_var, **extra)
+        except SystemExit as done:
+            end(done.code)
+
+    def _standalone(self, args, prog_name, complete_var, **extra):
         try:
             code = super().main(args, prog_name, complete_var, False, **extra)
         except getattr(click.exceptions, "NoArgsIsHelpError", ()) as err:

@@ -350,3 +350,28 @@ def test_coulomb_on_a_body_held_by_contact_alone_engages_from_zero_load():
     tangential = np.abs(solution.contact_force[:, :, 1])
     assert np.all(tangential <= bound * (1 + 1e-8) + 1e-12)
     assert np.abs(F[-1, 0]) > 0     # friction carries the shear
+
+
+def test_a_full_disk_ends_with_one_line_and_exit_1_not_a_crash(tmp_path):
+    """The disk filling during the run (past the free-space check: here
+    with --force) ended in SIGSEGV: the HDF5 library flushed and truncated
+    through a Python file already closed when it cleaned up at exit. Now
+    the run ends with exit 1, one line, and nothing left in the folder.
+    A full disk needs a small file system of its own: a 3 MB tmpfs."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
+                             capture_output=True, text=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"no tmpfs can be mounted here (not root?): {mounted.stderr.strip()}")
+    try:
+        data = scene_dict({"mesh.cells": [40, 10], "time.steps": 100}, BASE)
+        (tmp_path / "s.toml").write_text(to_toml(data))
+        result = cli("solve", str(tmp_path / "s.toml"), "--out", str(disk / "o"), "--force",
+                     "-q", cwd=tmp_path, timeout=120)
+        assert result.returncode == 1, (result.returncode, result.stderr)
+        assert result.stderr.strip().splitlines() == [
+            f"error: --out: cannot write {str(disk / 'o')!r}: No space left on device"]
+        assert list(disk.iterdir()) == []
+    finally:
+        subprocess.run(["umount", str(disk)], capture_output=True)

@@ -13,6 +13,18 @@ import contextlib
 
 #: h5py's mode -> the Python file mode it needs
 _MODES = {"w": "w+b", "a": "r+b", "r": "rb"}
+#: the Python files under HDF5 files whose close failed: HDF5 still holds
+#: them (its objects flush and truncate through them when they are freed,
+#: at the latest when the process ends), so they stay open until then; a
+#: closed one made that last truncate a segmentation fault on a full disk
+_HELD_OPEN = []
+
+
+def held_open():
+    """Whether an HDF5 file failed to close in this process (its Python
+    file is held open for the HDF5 library, which may crash when it cleans
+    up at exit: a caller may end the process without that clean-up)."""
+    return bool(_HELD_OPEN)
 
 
 class H5File:
@@ -34,6 +46,12 @@ class H5File:
         error of the two is raised after both are closed."""
         try:
             self.file.close()
-        finally:
+        except BaseException:
+            if self.file.id.valid:   # HDF5 still holds the file: leave it open
+                _HELD_OPEN.append(self.raw)
+                raise
             with contextlib.suppress(OSError):
                 self.raw.close()
+            raise
+        with contextlib.suppress(OSError):
+            self.raw.close()
