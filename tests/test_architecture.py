@@ -23,7 +23,7 @@ ALLOWED = {
               "verification.manufactured", "fem.meshes.builtin"},
     "fem": {"expressions", "scene"},
     "problem": {"expressions", "scene", "laws", "fem", "verification.manufactured",
-                "verification.admissibility"},
+                "verification.admissibility", "scheme.options"},
     "scheme": {"expressions", "scene", "laws", "step_methods", "linear_solvers"},
     "verification": BASE | {"scene", "fem", "problem", "scheme"},
     "postprocess": {"expressions", "fem"},

@@ -38,6 +38,7 @@ from ..fem.contact_boundary import (
     tangent_frame,
 )
 from ..fem.dirichlet import prescribed_displacement, rigid_modes
+from ..scheme.options import SchemeOptions, SolverOptions
 from ..fem.foundation import foundation_gap, foundation_normal, signed_distance
 from ..fem.meshes import build_mesh, named_facets
 from ..laws import make_bonding, make_friction, make_normal_law
@@ -85,7 +86,21 @@ def build_problem(scene):
                    beta0=beta0, normal_law=laws.normal, friction=laws.friction,
                    bonding=laws.bonding, probe_map=probe_map, times=times,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
-                   beta_source=beta_source, held_by_contact=held_by_contact)
+                   beta_source=beta_source, held_by_contact=held_by_contact,
+                   options=scheme_options(scene))
+
+
+def scheme_options(scene):
+    """The :class:`~adhesive_contact.scheme.options.SchemeOptions` of a
+    validated scene: all the scheme reads of it, resolved once."""
+    s = scene.solver
+    return SchemeOptions(
+        T=scene.T, steps=scene.steps, scheme=scene.scheme,
+        integrator=scene.contact.integrator, adaptive=scene.adaptive, memory=scene.memory,
+        material=scene.material, dim=scene.dim,
+        solver=SolverOptions(method=s.method, tol=s.tol, max_iter=s.max_iter,
+                             penalty=s.penalty, smoothing=s.smoothing, linear=s.linear,
+                             linear_tol=s.linear_tol))
 
 
 def time_grid(scene):

@@ -41,6 +41,7 @@ class Problem:
     exact: object = None      # ManufacturedSolution, for scenes with [exact]
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
     held_by_contact: tuple = ()  # the rigid motions only the contact terms hold, in words
+    options: object = None    # SchemeOptions: what the scheme reads of the scene
     _smallness: dict = field(default=None, repr=False)
     _geometry: tuple = field(default=None, repr=False)
 

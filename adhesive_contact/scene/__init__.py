@@ -19,11 +19,12 @@ line that names the key and says what is allowed.
 - :mod:`.parse`: the scene from a file, a TOML text or a dictionary.
 """
 
-from .errors import SceneError
+from .errors import SceneError, where
+from .materials import relaxation_step_definite
 from .parse import load_scene, parse_scene, scene_from_dict
 from .spec import (ContactSpec, ExactSpec, FoundationSpec, Isotropic, LawSpec, MemorySpec,
                    MeshSpec, PronyTerm, Scene, SolverSpec)
 
-__all__ = ["SceneError", "load_scene", "parse_scene", "scene_from_dict", "Scene", "MeshSpec",
+__all__ = ["SceneError", "where", "relaxation_step_definite", "load_scene", "parse_scene", "scene_from_dict", "Scene", "MeshSpec",
            "Isotropic", "PronyTerm", "MemorySpec", "LawSpec", "FoundationSpec", "ContactSpec",
            "ExactSpec", "SolverSpec"]

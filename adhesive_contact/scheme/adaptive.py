@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..scene.materials import relaxation_step_definite
+from ..scene import relaxation_step_definite
 
 
 @dataclass
@@ -58,24 +58,25 @@ class StepSizes:
     first: int = 0      # the largest allowed half step is k_max 2^{-first}
 
     @classmethod
-    def of(cls, scene, stable_step=math.inf):
-        """The step sizes of an adaptive ``scene`` with the explicit Euler
-        bound ``stable_step`` on every step (the doubled one included); with
-        a relaxation kernel the doubled step 2h also keeps the step tensor
-        C_∞ + Σ_i (1 − 2h/τ_i) C_i positive definite (the scene's check
-        holds k_max to it)."""
-        adaptive = scene.adaptive
-        k_max = scene.k
-        memory = scene.memory if (scene.memory is not None
-                                  and scene.memory.kernel == "relaxation") else None
+    def of(cls, options, stable_step=math.inf):
+        """The step sizes of an adaptive run of ``options`` (the
+        :class:`~.options.SchemeOptions`, or a Scene: the same attributes)
+        with the explicit Euler bound ``stable_step`` on every step (the
+        doubled one included); with a relaxation kernel the doubled step 2h
+        also keeps the step tensor C_∞ + Σ_i (1 − 2h/τ_i) C_i positive
+        definite (the scene's check holds k_max to it)."""
+        adaptive = options.adaptive
+        k_max = options.k
+        memory = options.memory if (options.memory is not None
+                                    and options.memory.kernel == "relaxation") else None
 
         def allowed(k):
             return k <= stable_step and (
-                memory is None or relaxation_step_definite(memory, scene.dim, k))
+                memory is None or relaxation_step_definite(memory, options.dim, k))
         first = 0
         while first < adaptive.halvings and not allowed(2.0 * k_max * 2.0 ** -first):
             first += 1
-        return cls(k_max, adaptive.halvings, scene.steps * 2 ** adaptive.halvings, first)
+        return cls(k_max, adaptive.halvings, options.steps * 2 ** adaptive.halvings, first)
 
     def size(self, j):
         """h_j = k_max 2^{−j}: exact, a power of two times k_max."""
@@ -106,14 +107,14 @@ class StepSizes:
         return j
 
 
-def memory_time(scene):
+def memory_time(options):
     """The time scale τ of the memory's error control: the shortest
     relaxation time of a Prony or relaxation kernel, T for a general
     kernel, ∞ without memory (no control)."""
-    if scene.memory is None:
+    if options.memory is None:
         return math.inf
-    tau = scene.memory.shortest_relaxation_time
-    return scene.T if tau is None else tau
+    tau = options.memory.shortest_relaxation_time
+    return options.T if tau is None else tau
 
 
 @dataclass
@@ -139,11 +140,13 @@ class Controller:
     forced: int = 0
 
     @classmethod
-    def of(cls, scene, stable_step=math.inf):
-        a = scene.adaptive
-        return cls(StepSizes.of(scene, stable_step), a.tol, scene.T,
-                   2 if scene.scheme == "second-order" else 1, a.rate_floor, a.growth,
-                   a.shrink, a.safety, memory_time(scene))
+    def of(cls, options, stable_step=math.inf):
+        """The controller of an adaptive run of ``options`` (as
+        :meth:`StepSizes.of`)."""
+        a = options.adaptive
+        return cls(StepSizes.of(options, stable_step), a.tol, options.T,
+                   2 if options.scheme == "second-order" else 1, a.rate_floor, a.growth,
+                   a.shrink, a.safety, memory_time(options))
 
     #: T_ℓ = T/LAG_SPAN: the lag a pair may make is tol T_ℓ
     LAG_SPAN = 64

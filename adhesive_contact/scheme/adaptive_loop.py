@@ -59,7 +59,7 @@ def explicit_bound(problem):
     integrator advances β (∞ otherwise)."""
     bonding = problem.bonding
     if (bonding is None or getattr(bonding, "rate_independent", False)
-            or problem.scene.contact.integrator != "explicit"):
+            or problem.options.integrator != "explicit"):
         return math.inf
     return float(bonding.stable_step())
 
@@ -70,18 +70,18 @@ def solve_adaptive(problem, progress=None, raise_on_failure=False, recorder=None
     accepted (nonuniform) levels and its ``adaptive`` the controller's
     figures."""
     t0 = time.perf_counter()
-    scene = problem.scene
-    trapezoid = scene.scheme == "second-order"
+    options = problem.options
+    trapezoid = options.second_order
     bound = explicit_bound(problem)
-    controller = Controller.of(scene, bound)
+    controller = Controller.of(options, bound)
     sizes = controller.sizes
-    cache = OperatorCache(problem, instantaneous_only(scene.memory, trapezoid), sizes)
+    cache = OperatorCache(problem, instantaneous_only(options.memory, trapezoid), sizes)
     first = cache.get(sizes.first, initial=True)   # level 0 and the first pair: k_max
     contact = (ContactStep(problem, first.within) if problem.boundary is not None else None)
     recorder = recorder or HistoryRecorder(problem)
     measure = (problem.boundary.measure if problem.boundary is not None
                else np.zeros(0))
-    norm = PairNorm(np.asarray(measure), scene.material.mu)
+    norm = PairNorm(np.asarray(measure), options.material.mu)
     run = _Run(problem, cache, contact, recorder, controller, norm, progress)
     t_loop = time.perf_counter()
     with one_blas_thread():
@@ -156,7 +156,7 @@ class _Run:
         if failure is not None:
             failure.result = failure.result if failure.result is not None else result
             return STEP_FAILED, failure
-        memory = start_memory(problem.scene.memory, problem.scene.scheme == "second-order", u)
+        memory = start_memory(problem.options.memory, problem.options.second_order, u)
         state = State(n=0, t=0.0, beta=state.beta, z=z, u=u, frame_u=frame_u, memory=memory)
         self.norm.scale(u)
         self.keep(level, 0)

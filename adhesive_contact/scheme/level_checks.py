@@ -23,7 +23,7 @@ says what failed, where, the figures and what to try.
 import numpy as np
 
 from ..laws.bonding import BEYOND_TIME_SCALE
-from ..scene.errors import where
+from ..scene import where
 from ..step_methods import EXACT
 from .solution import StepFailure
 
@@ -71,19 +71,19 @@ def check_level(problem, level):
         reason = (f"beta = {beta[facet]:.4g} leaves [0, 1] on the contact facet at "
                   f"{_facet_midpoint(problem, facet)}")
         bonding = problem.bonding
-        if bonding is not None and problem.scene.contact.integrator == "explicit":
-            k, bound = problem.scene.k, bonding.stable_step()
+        if bonding is not None and problem.options.integrator == "explicit":
+            k, bound = problem.options.k, bonding.stable_step()
             reason += (f". The explicit Euler step of the bonding law keeps beta in [0, 1] "
                        f"only for k (gamma_nu + gamma_tau) L^2 <= 1, i.e. k <= {bound:.4g}; "
                        f"this run has k = {k:.4g}")
-            if k > bound and problem.scene.adaptive is None:
-                need = int(np.ceil(problem.scene.T / bound))
+            if k > bound and problem.options.adaptive is None:
+                need = int(np.ceil(problem.options.T / bound))
                 reason += (f". Use at least time.steps = {need} or [time.adaptive] tol; "
                            f"{BEYOND_TIME_SCALE} "
                            f"(docs/scheme.md#accuracy-guides-of-the-time-step)")
         return InvalidState(n, t, reason)
     gap = problem.gap
-    exact = problem.scene.solver.method in EXACT
+    exact = problem.options.solver.method in EXACT
     if exact and gap is not None and level.frame_displacement.shape[0]:
         u_nu = level.frame_displacement[:, 0]
         # the wall acts where u_ν is free: a held u_ν is the scene's to set

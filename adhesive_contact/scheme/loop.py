@@ -49,7 +49,7 @@ def solve(problem, progress=None, raise_on_failure=False, recorder=None):
     -------
     Solution : ``success``, ``status``, ``message`` say how the run ended.
     """
-    if problem.scene.adaptive is not None:   # [time.adaptive]: scheme/adaptive_loop.py
+    if problem.options.adaptive is not None:   # [time.adaptive]: scheme/adaptive_loop.py
         return solve_adaptive(problem, progress, raise_on_failure, recorder)
     t0 = time.perf_counter()
     memory = start_memory(problem)
@@ -105,6 +105,6 @@ def march(problem, operators, contact, recorder, state, progress=None):
         state = State(n=n, t=t, beta=beta, z=z, u=u, frame_u=frame_u, memory=state.memory,
                       z_before=state.z if n >= 1 else None,
                       frame_u_before=state.frame_u if n >= 1 else None)
-        if progress is not None and progress(n, problem.scene.steps) is True:
-            return (STOPPED if n < problem.scene.steps else SUCCESS), None, state
+        if progress is not None and progress(n, problem.options.steps) is True:
+            return (STOPPED if n < problem.options.steps else SUCCESS), None, state
     return SUCCESS, None, state

@@ -144,4 +144,4 @@ def make_memory(spec, trapezoid=False):
 def start_memory(problem):
     """A fresh memory history for one run of ``problem`` (the rule of its
     ``time.scheme``): a Problem is never changed by a run."""
-    return make_memory(problem.scene.memory, problem.scene.scheme == "second-order")
+    return make_memory(problem.options.memory, problem.options.second_order)

@@ -91,7 +91,7 @@ class StepOperators:
         assembly, free = problem.assembly, problem.free
         R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
         contact = problem.contact_positions
-        method, reason = problem.scene.solver.linear, "method {!r} was asked for."
+        method, reason = problem.options.solver.linear, "method {!r} was asked for."
         if method == "auto":   # nnz of the free block, pro rata of the free dofs
             nnz = int(assembly.K_mu.nnz * free.size / max(assembly.ndofs, 1))
             method, reason = choose(free.size, nnz, problem.dim,
@@ -104,7 +104,7 @@ class StepOperators:
             # rotated dofs at Γ_C only weaken its near-nullspace there)
             solver = make_linear_solver(A_II, method, dim=problem.dim, points=problem.mesh.p,
                                         dofs=free[interior],
-                                        tol=problem.scene.solver.linear_tol)
+                                        tol=problem.options.solver.linear_tol)
             solver.reason = reason
             return solver
 
@@ -132,7 +132,7 @@ class StepOperators:
         # with AMG the step method iterates on all free dofs (a Schur complement
         # would cost one CG solve per contact unknown), if it can (FULL_SYSTEM)
         unreduced = (method == "amg" and contact.size > 0
-                     and problem.scene.solver.method in FULL_SYSTEM)
+                     and problem.options.solver.method in FULL_SYSTEM)
 
         def step_operator(lam, mu, nearby=None):
             """The operator of (λ, μ) on the free dofs; ``nearby`` is what the
@@ -161,9 +161,9 @@ class StepOperators:
                 unshift(operator, delta)
             return operator
 
-        material = problem.scene.material
+        material = problem.options.material
         elastic = (material.lam, material.mu)
-        dlam, dmu = memory.instantaneous(problem.scene.k if k is None else k)
+        dlam, dmu = memory.instantaneous(problem.options.k if k is None else k)
         stepped = (material.lam + dlam, material.mu + dmu)
         step = step_operator(*stepped)
         wanted, initial, shift, rho = initial, step, None, 0.0
@@ -255,6 +255,6 @@ def _newton_unknowns(problem):
     """The contact unknowns of a step, for the backend choice: 0 for the step
     methods not in FULL_SYSTEM, which need the Schur complement whatever the
     backend."""
-    if problem.scene.solver.method not in FULL_SYSTEM:
+    if problem.options.solver.method not in FULL_SYSTEM:
         return 0
     return int(problem.contact_positions.size)

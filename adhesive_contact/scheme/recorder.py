@@ -14,7 +14,7 @@ class HistoryRecorder:
 
     def __init__(self, problem):
         mesh, boundary, d = problem.mesh, problem.boundary, problem.dim
-        levels = problem.scene.steps + 1
+        levels = problem.options.steps + 1
         npoints, ncells = mesh.p.shape[1], mesh.t.shape[1]
         nc = 0 if boundary is None else boundary.nodes.size
         nf = 0 if boundary is None else boundary.facets.size

@@ -135,7 +135,7 @@ class ContactStep:
         self.energy.set_bonding(beta)
         self.energy.set_pressure(z0)   # a Coulomb bound: at the last level's pressure first
         self.set_radius()
-        solver = problem.scene.solver
+        solver = problem.options.solver
         options = self.options(S)
         if solver.method in NEWTON:
             options = replace(options, tol=max(options.tol * tighter, 1e-14))
@@ -189,7 +189,7 @@ class ContactStep:
         mu = max(float(getattr(law, "mu", 0.0)) for law in self.energy.friction_law.laws)
         self.energy.set_pressure_values(np.full(w.size, large / max(mu, 1e-300)))
         self.set_radius()
-        stuck = minimise(self.problem.scene.solver.method, S, c, self.energy, upper, z0,
+        stuck = minimise(self.problem.options.solver.method, S, c, self.energy, upper, z0,
                          options, self.kink)
         before = 0 if failed is None else failed.nit
         if not stuck.success:
@@ -201,7 +201,7 @@ class ContactStep:
             return failed
         self.energy.set_pressure(stuck.z)
         self.set_radius()
-        result = minimise(self.problem.scene.solver.method, S, c, self.energy, upper, stuck.z,
+        result = minimise(self.problem.options.solver.method, S, c, self.energy, upper, stuck.z,
                           options, self.kink)
         result.nit += before + stuck.nit
         return result
@@ -215,7 +215,7 @@ class ContactStep:
         residual with the bound at its own solution is below the tolerance
         too. Not converging in ``max_iter`` passes is the step's failure
         (MAX_ITERATIONS, with the change reached)."""
-        passes = max(int(self.problem.scene.solver.max_iter), 1)
+        passes = max(int(self.problem.options.solver.max_iter), 1)
         nit = result.nit
         for _ in range(passes):
             before = self.kink.radius.copy()
@@ -225,7 +225,7 @@ class ContactStep:
             if change <= options.tol * max(self.kink.radius.max(initial=0.0), 1e-300):
                 result.nit = nit
                 return result
-            result = minimise(self.problem.scene.solver.method, S, c, self.energy, upper,
+            result = minimise(self.problem.options.solver.method, S, c, self.energy, upper,
                               result.z, options, self.kink)
             nit += result.nit
             if not result.success:
@@ -304,7 +304,7 @@ class ContactStep:
         SECOND_START_RTOL of the larger. The run goes on with ``result``."""
         if not np.any(z0):
             return
-        other = minimise(self.problem.scene.solver.method, S, c, self.energy, upper,
+        other = minimise(self.problem.options.solver.method, S, c, self.energy, upper,
                          np.zeros_like(z0), options, self.kink)
         if not other.success:
             return
@@ -317,7 +317,7 @@ class ContactStep:
     def options(self, S):
         """The StepOptions of a step with matrix S: the scene's tolerances and,
         for "penalty", ρ = penalty · max_i S_ii and δ = smoothing · diam Ω."""
-        solver = self.problem.scene.solver
+        solver = self.problem.options.solver
         if solver.method != "penalty":
             return StepOptions(solver.tol, solver.max_iter)
         p = self.problem.mesh.p
@@ -332,9 +332,9 @@ def initial_state(problem, memory, unknowns=None):
     ``unknowns`` the size of the step unknowns (default: the contact
     unknowns)."""
     nc = 0 if problem.boundary is None else problem.boundary.nodes.size
-    memory.begin(problem.scene.k, problem.ndofs)
+    memory.begin(problem.options.k, problem.ndofs)
     size = problem.columns.size if unknowns is None else unknowns
-    return State(n=-1, t=-problem.scene.k, beta=problem.beta0.copy(),
+    return State(n=-1, t=-problem.options.k, beta=problem.beta0.copy(),
                  z=np.zeros(size), u=np.zeros(problem.ndofs),
                  frame_u=np.zeros(nc * problem.dim), memory=memory)
 
@@ -359,8 +359,8 @@ def bonding_step(problem, state, k=None):
     boundary = problem.boundary
     frame_u, t = state.frame_u, state.t
     uniform = k is None
-    k = problem.scene.k if uniform else k
-    if problem.scene.scheme == "second-order":
+    k = problem.options.k if uniform else k
+    if problem.options.second_order:
         t = state.t + 0.5 * k
         if state.frame_u_before is not None:
             if uniform:
@@ -377,7 +377,7 @@ def bonding_step(problem, state, k=None):
     if problem.beta_source is not None:   # manufactured solutions only
         source = problem.beta_source(*coordinates(boundary.points), t=t)
     rate = FacetRate(problem.bonding, r, xi, boundary.at_points, boundary.facet_mean, source)
-    return advance(problem.scene.contact.integrator, rate, state.beta, k)
+    return advance(problem.options.integrator, rate, state.beta, k)
 
 
 @dataclass
@@ -521,7 +521,7 @@ def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13
     u = np.zeros(b.size)
     # ρ^i below rtol, with a margin for the contact terms' nonlinearity
     limit = 10 + int(np.log(rtol) / np.log(max(contraction, 1e-3)))
-    budget = 0 if contact is None else int(contact.problem.scene.solver.max_iter)
+    budget = 0 if contact is None else int(contact.problem.options.solver.max_iter)
     total = settled = unsettled = 0
     while settled < limit:
         u_next, z0, c, result = free_solve(step, contact, n, b + shift @ u, beta, z0,
