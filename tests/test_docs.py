@@ -261,3 +261,29 @@ def test_a_wrong_option_in_a_usage_line_would_be_caught(tmp_path):
         check_adhcontact("adhcontact solve SCENE.toml [--output DIR]", tmp_path, tmp_path)
     assert check_adhcontact("adhcontact solve SCENE.toml [--out DIR]", tmp_path,
                             tmp_path) == "ran"
+
+
+def readme_row(table):
+    """The keys cell of the README's scene table row of ``table``."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    row = re.search(rf"^\| `{re.escape(table)}` \| (.*) \|$", text, re.MULTILINE)
+    assert row, f"README.md has no row for {table}"
+    return row.group(1)
+
+
+def test_the_readme_scene_table_names_every_law_and_integrator():
+    """README.md's table of scenes names every law of the registries, every
+    bonding integrator and every mesh pattern (a law left out of it, as
+    coulomb and cohesive were, is a law a new user does not find)."""
+    from adhesive_contact.laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
+    from adhesive_contact.scene.keys import KEYS
+    from adhesive_contact.scheme.bonding import INTEGRATORS
+    wanted = {"[contact.normal]": NORMAL_LAWS, "[contact.friction]": FRICTION_LAWS,
+              "[contact.bonding]": {**BONDING_LAWS, **INTEGRATORS}}
+    for table, names in wanted.items():
+        row = readme_row(table)
+        missing = [name for name in names if f"`{name}`" not in row]
+        assert not missing, f"README.md's {table} row leaves out {missing}"
+    patterns = {p for choices in KEYS["mesh.pattern"].choices.values() for p in choices}
+    row = readme_row("[mesh]")
+    assert patterns and all(f"`{p}`" in row for p in patterns)

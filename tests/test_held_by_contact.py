@@ -192,3 +192,43 @@ def test_the_summary_and_check_of_a_body_held_by_contact(tmp_path):
     assert checked.exit_code == 0
     assert ("the conditions do not apply: only the contact terms hold the body against "
             "translation along y") in checked.output
+
+
+#: a 1 × 0.5 × 1 box on a compliant layer at its bottom (y = 0), pressed on top
+BOX = {"dim": 3, "mesh": {"domain": "box", "size": [1.0, 0.5, 1.0], "cells": [4, 2, 4]},
+       "boundary": {"dirichlet": [], "contact": ["bottom"]},
+       "material": {"E": 1000.0, "nu": 0.3},
+       "loads": {"traction": {"top": ["0", "-10*t", "0"]}},
+       "contact": {"normal": {"law": "compliance", "c": 1e4}},
+       "time": {"T": 1.0, "steps": 1}}
+
+
+@pytest.mark.parametrize("displacement, held", [
+    # u_x = u_z = 0 on the left: only the vertical translation is left, which
+    # the layer holds; its SVD basis vector has a rotation part of round-off
+    # size, which was named a rotation about an axis through a point 1e15 away
+    ({"left": ["0", "free", "0"]}, ("translation along y",)),
+    ({"front": ["0", "free", "0"]}, ("translation along y",)),
+    # u_x = u_z = 0 on the top y = 0.5: the turns about x and z through a
+    # point of the top, the one of each axis nearest the centroid
+    ({"top": ["0", "free", "0"]}, ("translation along y",
+                                   "rotation about the axis along x through (0.5, 0.5, 0.5)",
+                                   "rotation about the axis along z through (0.5, 0.5, 0.5)")),
+])
+def test_3d_a_translation_held_by_contact_is_named_a_translation(displacement, held):
+    problem = build_problem(scene_from_dict(scene_dict(
+        {"boundary.displacement": displacement}, base=BOX)))
+    assert problem.held_by_contact == held
+    line = next(w for w in problem.warnings() if w.startswith("only the contact terms"))
+    assert line.startswith(f"only the contact terms hold the body against {', '.join(held)}:")
+    assert "e+" not in line
+
+
+def test_3d_the_refusal_names_the_free_translation_alone():
+    """u_x held on the left, the layer holding the lift and the tilts: the
+    slide along z is free, and named so (not a rotation with a shift)."""
+    with pytest.raises(SceneError) as err:
+        build_problem(scene_from_dict(scene_dict(
+            {"boundary.displacement": {"left": ["0", "free", "free"]}}, base=BOX)))
+    message = str(err.value)
+    assert "leave the body free to move rigidly (translation along z):" in message

@@ -256,12 +256,14 @@ def free_rigid_motions(modes, fixed):
     return _null_space(modes[fixed], modes.shape[1])
 
 
-def _null_space(B, n, rtol=1e-8):
-    """An orthonormal basis (n, k) of the null space of B (m, n)."""
+def _null_space(B, n, rtol=1e-8, atol=0.0):
+    """An orthonormal basis (n, k) of the null space of B (m, n): the
+    singular values up to ``rtol`` times the largest, or up to ``atol``,
+    count as zero."""
     if B.shape[0] == 0 or n == 0:
         return np.eye(n)
     _, sv, vt = np.linalg.svd(B, full_matrices=True)
-    rank = int((sv > rtol * max(sv[0], 1e-300)).sum()) if sv.size else 0
+    rank = int((sv > max(rtol * sv[0], atol, 1e-300)).sum()) if sv.size else 0
     return vt[rank:].T
 
 
@@ -363,6 +365,9 @@ def _check_motions(modes, points, fixed, sides, contact=None):
 
 
 _AXES = "xyz"
+#: a rotation part below this (mode coordinates: the displacement of the
+#: farthest point per unit motion) is round-off, not a rotation
+ROTATION_TOL = 1e-8
 
 
 def _direction(v, digits=3):
@@ -392,7 +397,12 @@ def describe_motions(free, points):
     centre = points.mean(axis=1)
     scale = max(np.abs(points - centre[:, None]).max(), 1e-300)
     t, w = free[:d], free[d:] / scale   # u(x) = t + W (x − centre), W of w
-    only_translations = _null_space(w, free.shape[1])   # (k, kt)
+    # the columns of ``free`` are unit vectors of mode coordinates, whose
+    # rotations move the farthest point by their size: a rotation part of
+    # round-off size (1e-16, what an SVD leaves of a pure translation) is
+    # no rotation, whatever the largest rotation part of the span (a
+    # relative test made it one, about an axis through a point 1e15 away)
+    only_translations = _null_space(free[d:], free.shape[1], atol=ROTATION_TOL)   # (k, kt)
     translations = _orthonormal(t @ only_translations)
     words = [f"translation along {_direction(e)}" for e in translations.T]
     rest = (_null_space(only_translations.T, free.shape[1]) if only_translations.shape[1]
