@@ -184,7 +184,7 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
         click.echo(f"note: --levels {levels}: a least-squares rate is meaningful only over "
                    f">= {MEANINGFUL_LEVELS} levels (docs/verification.md)", err=True)
 
-    bars = Progress(name, study)
+    bars = Progress(name, study, per_level=executor is None and (jobs or 1) == 1)
     try:
         with running_study(out, executor, "levels"):
             result = study.run(jobs=jobs or 1, executor=executor, progress=bars)
@@ -210,12 +210,27 @@ def converge(scene, param, levels, reference, jobs, scheduler, ref_h, ref_k, bas
 
 
 class Progress:
-    """The study's progress callback: a bar for the reference run, one for the levels."""
+    """The study's progress callback (stderr): a bar for the reference run;
+    then, when the levels run here (``per_level``), a line naming the study
+    and a bar per level over its steps, labelled with the level, its
+    refinement and steps; else (local workers, a cluster, whose runs cannot
+    report to this process) one bar of the finished levels."""
 
-    def __init__(self, name, study):
-        self.name, self.study, self.bar, self.stage = name, study, None, None
+    def __init__(self, name, study, per_level=False):
+        self.name, self.study, self.per_level = name, study, per_level
+        self.bar, self.stage = None, None
 
     def __call__(self, stage, done, total):
+        if stage == "levels" and (self.per_level or self.stage and self.stage.startswith(
+                "level ")):
+            if self.stage != "levels":
+                self.close()
+                if self.stage is None or self.stage == "reference":
+                    loaded = f", {done} loaded from the folder" if done else ""
+                    click.echo(f"{self.name}: {self.study.param}-study, {total} levels"
+                               f"{loaded}", err=True)
+                self.stage = "levels"
+            return
         if stage != self.stage:
             self.close()
             self.stage = stage
@@ -224,10 +239,15 @@ class Progress:
                 click.echo(f"reference: refine {rscene.mesh.refine}, {rscene.steps} steps ...",
                            err=True)
                 label = "reference run"
+            elif stage.startswith("level "):
+                level = int(stage.split()[1])
+                lscene = level_scene(self.study.scene, self.study.param, level)
+                label = (f"level {level} ({level + 1} of {self.study.levels}): refine {lscene.mesh.refine}, "
+                         f"{lscene.steps} steps")
             else:
                 label = f"{self.name}: {self.study.param}-study, {total} levels"
             self.bar = click.progressbar(length=total, file=sys.stderr, label=label,
-                                         show_pos=stage != "reference")
+                                         show_pos=stage == "levels")
             self.bar.__enter__()
         self.bar.update(done - self.bar.pos)
 

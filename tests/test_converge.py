@@ -230,6 +230,21 @@ def test_fine_reference_k_study(fine_study, scenes):
     assert "u, β: the fine reference run" in fine_study.result.stdout
 
 
+def test_the_progress_names_each_level_and_its_run(exact_study, fine_study):
+    """Levels run here: a line naming the study, then a bar per level over
+    its steps, labelled with the level, its refinement and its steps (on
+    stderr; a bar that is not on a terminal shows its label)."""
+    err = exact_study.result.stderr.splitlines()
+    assert "exact: h-study, 3 levels" in err
+    labels = [line for line in err if line.startswith("level ")]
+    assert labels == ["level 0 (1 of 3): refine 0, 8 steps",
+                      "level 1 (2 of 3): refine 1, 8 steps",
+                      "level 2 (3 of 3): refine 2, 8 steps"]
+    err = fine_study.result.stderr.splitlines()
+    assert err.index("reference run") < err.index("contact: k-study, 3 levels") < err.index(
+        "level 0 (1 of 3): refine 0, 2 steps") < err.index("level 2 (3 of 3): refine 0, 8 steps")
+
+
 # ---------------------------------------------------------------- (3) resume
 
 
@@ -285,6 +300,10 @@ def test_interrupted_study_computes_only_the_missing_levels(fine_study, tmp_path
     result = run(scenes.contact, "--param", "k", "--levels", 3, "--out", out)
     assert result.exit_code == 0, result.stderr
     assert counting.levels == [0, 1, 2] and counting.reference == 1   # only level 2 now
+    err = result.stderr.splitlines()
+    assert "contact: k-study, 3 levels, 2 loaded from the folder" in err
+    assert [line for line in err if line.startswith("level ")] == [
+        "level 2 (3 of 3): refine 0, 8 steps"]
     resumed = strict_json(out / "rates.json")
     whole = strict_json(fine_study.out / "rates.json")
     for key in ("err_u", "err_beta", "E", "h", "k", "dofs"):
@@ -384,6 +403,9 @@ def test_parallel_levels_give_the_same_errors(fine_study, tmp_path, scenes):
         np.testing.assert_allclose([level[key] for level in parallel],
                                    [level[key] for level in serial], rtol=0, atol=1e-12)
     assert [level["steps"] for level in parallel] == [2, 4, 8]
+    # in workers the runs cannot report their steps here: one bar of the levels
+    assert "contact: k-study, 3 levels" in result.stderr.splitlines()
+    assert not [line for line in result.stderr.splitlines() if line.startswith("level ")]
 
 
 def test_step_failure_exits_1_in_the_reference_and_in_a_worker(fine_study, tmp_path, counting):

@@ -178,7 +178,18 @@ def test_convergence_study_from_python(tmp_path, monkeypatch, capsys):
     assert capsys.readouterr() == ("", "")           # the library prints nothing
     assert calls == [0, 1, 2] and result.computed == [0, 1, 2]
     assert result.reference_loaded is None
-    assert events == [("levels", 0, 3), ("levels", 1, 3), ("levels", 2, 3), ("levels", 3, 3)]
+    # in this process each level reports its time levels done, 0 to steps + 1,
+    # between the finished-levels counts
+    assert [e for e in events if e[0] == "levels"] == [
+        ("levels", 0, 3), ("levels", 1, 3), ("levels", 2, 3), ("levels", 3, 3)]
+    stages = [e[0] for e in events]
+    steps = study.scene.steps
+    for level in range(3):
+        mine = [e for e in events if e[0] == f"level {level}"]
+        assert mine == [(f"level {level}", n, steps + 1) for n in range(steps + 2)]
+        first = stages.index(f"level {level}")
+        assert events[first - 1] == ("levels", level, 3)
+        assert events[first + len(mine)] == ("levels", level + 1, 3)
     doc = result.document
     assert set(doc) >= {"param", "levels", "rates"} and doc["param"] == "h"
     assert [level["dofs"] for level in doc["levels"]] == [30, 90, 306]

@@ -49,6 +49,7 @@ from ..verification.levels import (
     PARAMS,
     Reference,
     default_reference_refinement,
+    level_scene,
     reference_scene,
     run_level,
     run_reference,
@@ -58,7 +59,7 @@ from ..fem.meshes import build_mesh
 from ..scene import SceneError, scene_from_dict
 from ..scene.materials import check_relaxation_step
 from ..storage import write_atomic, write_json
-from .pool import attempt
+from .pool import attempt, in_this_process
 from .study import RunFailed, Study, StudyError, scene_identity, scene_source
 
 REFERENCE = "reference.npz"
@@ -267,8 +268,27 @@ def _setup(source, base, param, levels, ref_h, ref_k, reference):
 
 
 def _compute_level(state, level):
-    return run_level(state.scene, state.param, level, state.reference,
+    report = getattr(state, "progress", None)   # set only where the level runs here
+    on_step = None
+    if report is not None:
+        stage = f"level {level}"
+        report(stage, 0, level_scene(state.scene, state.param, level).steps + 1)
+
+        def on_step(n, N):
+            report(stage, min(n, N) + 1, N + 1)
+    return run_level(state.scene, state.param, level, state.reference, progress=on_step,
                      measure=study_quantities)
+
+
+def _reporting(setup, progress):
+    """``setup`` whose state also carries ``progress``: for levels computed in
+    this process, which then report their steps (not for workers: a
+    callback of this process does not reach them)."""
+    def build(*args):
+        state = setup(*args)
+        state.progress = progress
+        return state
+    return build
 
 
 # ---------------------------------------------------------------- the study
@@ -485,8 +505,12 @@ class ConvergenceStudy(Study):
             reference runs first, alone, in this process.
         progress : callable (stage, done, total), optional
             Called with stage ``"reference"`` (done = time levels of the
-            reference run, from 0) and ``"levels"`` (done = finished levels,
-            first with those loaded from the folder).
+            reference run, from 0), ``"levels"`` (done = finished levels,
+            first with those loaded from the folder) and, when the levels
+            run in this process (no executor, and ``jobs`` 1 or one level
+            missing), ``"level L"`` for each level L computed (done = its
+            time levels, from 0, of total = its steps + 1), between the
+            ``"levels"`` calls before and after it.
 
         Returns
         -------
@@ -516,6 +540,8 @@ class ConvergenceStudy(Study):
                 info["quantity"] = fine.quantities[self.quantity]
         progress("levels", len(done), self.levels)
         setup, args = self.context(fine)
+        if in_this_process(jobs, executor, len(missing)):
+            setup = _reporting(setup, progress)
         computed = self.run_missing(
             done, jobs=jobs, executor=executor, as_completed=as_completed,
             on_record=lambda level, record: progress("levels", len(done), self.levels),

@@ -85,6 +85,13 @@ def lost_message(err):
     return f"lost: the worker computing it died or was cut off ({type(err).__name__}: {what})"
 
 
+def in_this_process(jobs, executor, count):
+    """Whether :func:`execute` computes ``count`` runs here, one after the
+    other (no executor, and one job or one run), where a run may report
+    its own progress."""
+    return executor is None and (jobs == 1 or count == 1)
+
+
 def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
             as_completed=None, on_lost=None):
     """Compute the runs ``keys``; call ``on_record(key, record)`` as each finishes.
@@ -125,7 +132,7 @@ def execute(keys, compute, context, on_record, *, token, jobs=1, executor=None,
     keys = list(keys)
     if not keys:
         return None
-    if executor is None and (jobs == 1 or len(keys) == 1):
+    if in_this_process(jobs, executor, len(keys)):
         state = context[0](*context[1])
         for key in keys:
             key, record, message = attempt(compute, state, key)
