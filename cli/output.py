@@ -30,6 +30,7 @@ from adhesive_contact.problem.warnings import solution_warnings
 from adhesive_contact.resources import estimate
 from adhesive_contact.scheme import STEP_FAILED, STOPPED, SUCCESS
 from adhesive_contact.storage import json_number, read_json, write_json
+from adhesive_contact.threads import one_blas_thread
 from adhesive_contact.visuals import PLOT_NAMES, write_plots
 
 from .summary import energy_record, smallness_record, step_records
@@ -163,10 +164,12 @@ def write_results(solution, folder, failures=None, source=None, lines=None):
     the scene's text and folder, ``lines`` the run's warnings if known
     (:func:`summary`)."""
     folder = Path(folder)
-    history = energies(solution)   # once, for summary.json and the figures
-    write_summary(solution, folder / "summary.json", source, history, lines)
-    write_npz(solution, folder / "solution.npz")
-    return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures, history)
+    with one_blas_thread():   # level-sized products (adhesive_contact.threads)
+        history = energies(solution)   # once, for summary.json and the figures
+        write_summary(solution, folder / "summary.json", source, history, lines)
+        write_npz(solution, folder / "solution.npz")
+        return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures,
+                                                               history)
 
 
 def write_outputs(solution, out, failures=None, source=None):

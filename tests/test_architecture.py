@@ -13,22 +13,23 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "adhesive_contact"
 CLI = ROOT / "cli"
 
-BASE = {"expressions", "storage", "laws", "step_methods", "linear_solvers"}
+BASE = {"expressions", "storage", "threads", "laws", "step_methods", "linear_solvers"}
 #: package -> what it may import (docs/architecture.md); a dotted entry
 #: allows one module of a package
 ALLOWED = {
-    "expressions": set(), "storage": set(), "laws": set(), "step_methods": set(),
+    "expressions": set(), "storage": set(), "threads": set(), "laws": set(),
+    "step_methods": set(),
     "linear_solvers": set(), "folders": {"storage"},
     "scene": {"expressions", "laws", "step_methods", "linear_solvers", "scheme.bonding",
               "verification.manufactured", "fem.meshes.builtin"},
     "fem": {"expressions", "scene"},
     "problem": {"expressions", "scene", "laws", "fem", "verification.manufactured",
                 "verification.admissibility", "scheme.options"},
-    "scheme": {"expressions", "scene", "laws", "step_methods", "linear_solvers"},
+    "scheme": {"expressions", "threads", "scene", "laws", "step_methods", "linear_solvers"},
     "verification": BASE | {"scene", "fem", "problem", "scheme"},
-    "postprocess": {"expressions", "fem"},
+    "postprocess": {"expressions", "threads", "fem"},
     "visuals": {"postprocess", "storage"},
-    "io": {"scene", "problem", "scheme", "postprocess", "storage"},
+    "io": {"scene", "problem", "scheme", "postprocess", "storage", "threads"},
     "resources": {"scene", "fem", "linear_solvers", "scheme"},
     "studies": BASE | {"scene", "fem", "problem", "scheme", "verification", "postprocess",
                        "io", "resources", "folders", ""},

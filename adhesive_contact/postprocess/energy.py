@@ -62,6 +62,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..threads import one_blas_thread
+
 #: the stored and dissipated parts, in the order of the figure and summary.json
 STORED = ("elastic", "memory", "layer", "glue", "friction")
 DISSIPATED = ("viscous", "debonding", "numerical")
@@ -305,9 +307,10 @@ def energies(solution):
     problem = solution.problem
     if energy_unavailable(problem) is not None:
         return None
-    elastic, memory, viscous, numerical = bulk_energies(problem, solution.u)
-    layer, glue, friction, debonding, bregman, wall = contact_energies(solution)
-    work = np.cumsum(external_work_increments(solution) + wall)
+    with one_blas_thread():   # level-sized products: threads only wait on each other
+        elastic, memory, viscous, numerical = bulk_energies(problem, solution.u)
+        layer, glue, friction, debonding, bregman, wall = contact_energies(solution)
+        work = np.cumsum(external_work_increments(solution) + wall)
     return EnergyHistory(
         t=np.asarray(solution.t, dtype=float).copy(), external_work=work,
         stored={"elastic": elastic, "memory": memory, "layer": layer, "glue": glue,

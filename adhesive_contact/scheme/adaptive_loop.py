@@ -32,7 +32,7 @@ from .operators import StepOperators
 from .recorder import HistoryRecorder
 from .solution import STEP_FAILED, STOPPED, SUCCESS, Solution, StepFailure
 from .state import ContactStep, State, bonding_step, history_load, step_solve
-from .threads import one_blas_thread
+from ..threads import one_blas_thread
 
 
 class OperatorCache:

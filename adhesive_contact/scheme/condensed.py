@@ -31,7 +31,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, cg
 
 from ..linear_solvers import SuperLUSolver
-from .threads import all_blas_threads
+from ..threads import all_blas_threads
 
 #: from this size on, a dense Newton system is factorised in single precision
 MIXED_FROM = 1000

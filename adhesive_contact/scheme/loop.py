@@ -29,7 +29,7 @@ from .state import (
     step_load,
     step_solve,
 )
-from .threads import one_blas_thread
+from ..threads import one_blas_thread
 
 
 def solve(problem, progress=None, raise_on_failure=False, recorder=None):
