@@ -219,12 +219,13 @@ def solve_command(scene, out, force, quiet):
     from adhesive_contact.problem.warnings import solution_warnings
     from adhesive_contact.scheme import STOPPED
 
-    from .output import OUTPUT_NAMES, holds_complete_run, staged_output, write_results
+    from adhesive_contact.io.folder import (holds_complete_run, output_names, staged_output,
+                                            write_results)
 
     name, text = read_scene(scene)
     out = Path(out) if out is not None else Path.cwd() / name
     parsed, problem = load_scene(text, scene_folder(scene), force, out)
-    check_out(out, OUTPUT_NAMES)
+    check_out(out, output_names())
     if not quiet:
         echo_warnings(problem)
     base = scene_folder(scene)   # summary.json keeps the scene to rebuild the problem from

@@ -227,7 +227,7 @@ def test_no_free_energy(memory, needle):
 def test_summary_records_the_firm_names():
     """summary.json's steps[].energy: the firm keys, each part as computed,
     the totals their sums; steps[].debonding: the areas and the front."""
-    from adhesive_contact_cli.summary import step_records
+    from adhesive_contact.io.summary import step_records
 
     _, solution = run(default_scene())
     e = energies(solution)

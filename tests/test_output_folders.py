@@ -1,4 +1,4 @@
-"""Output folders under faults (adhesive_contact/folders.py, cli/output.py):
+"""Output folders under faults (adhesive_contact/folders.py, adhesive_contact/io/folder.py):
 a folder that held a whole run holds it or the new whole run after a
 failed publish, a SIGKILL at every step of the publish, a file-size limit
 (the disk filling up) and a concurrent publisher; staging folders are known

@@ -7,14 +7,19 @@
   :func:`adhesive_contact.solve` that writes each level to those files as it
   is computed and keeps in memory only what is small (per contact node or
   facet, per probe): the memory of a run is flat in the number of steps;
+- :mod:`.summary`: ``summary.json``, written and read (its one schema);
+- :mod:`.folder`: :func:`write_outputs`, a whole output folder written as
+  ``adhcontact solve`` writes it (staged, published whole);
 - :mod:`.load`: :func:`load_solution`, an output folder read back as the
   Solution that ``solve`` returns.
 """
 
-from .load import OutputFolderError, load_solution
+from .errors import OutputFolderError
+from .folder import write_outputs
+from .load import load_solution
 from .npz import write_npz
 from .streaming import StreamingRecorder
 from .xdmf import XdmfSeries, write_xdmf
 
 __all__ = ["OutputFolderError", "StreamingRecorder", "XdmfSeries", "load_solution",
-           "write_npz", "write_xdmf"]
+           "write_npz", "write_outputs", "write_xdmf"]

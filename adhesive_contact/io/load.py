@@ -16,49 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..scheme import STEP_FAILED, STOPPED, SUCCESS, Solution
+from ..scheme import Solution
 from ..storage import plain
+from .errors import OutputFolderError
 from .npz import SOLUTION_KEYS
-
-#: summary.json's run.status -> Solution.status
-STATUS = {"complete": SUCCESS, "step failed": STEP_FAILED, "interrupted": STOPPED}
-#: the summary.json layout this reads
-SCHEMA = 2
-
-
-class OutputFolderError(ValueError):
-    """A folder that cannot be read back: ``path`` names the file at fault,
-    ``str(err)`` is ``"<path>: what is wrong"``."""
-
-    def __init__(self, path, message):
-        self.path = Path(path)
-        super().__init__(f"{self.path}: {message}")
-
-
-def read_summary(path):
-    """The ``summary.json`` document at ``path``, of this layout (schema :data:`SCHEMA`)."""
-    try:
-        document = json.loads(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise OutputFolderError(path, "no such file; an output folder of 'adhcontact solve' "
-                                "has one (docs/outputs.md)") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise OutputFolderError(path, f"cannot be read: {err}") from None
-    except json.JSONDecodeError as err:
-        raise OutputFolderError(path, f"not valid JSON ({err}): the file is damaged; run "
-                                "the scene again") from None
-    except RecursionError:
-        raise OutputFolderError(path, "is nested too deeply to be a summary.json: the file "
-                                "is damaged; run the scene again") from None
-    if not isinstance(document, dict) or document.get("schema") != SCHEMA:
-        found = document.get("schema") if isinstance(document, dict) else None
-        raise OutputFolderError(path, f"has schema {found!r}; this version reads schema "
-                                f"{SCHEMA}: run the scene again with it")
-    for key in ("scene", "run", "steps"):
-        if key not in document:
-            raise OutputFolderError(path, f"has no {key!r}: the file is damaged")
-    return document
-
+from .summary import STATUS_CODES, read_summary
 
 #: the kinds of numpy dtype each kind of array may have ("f" floats, "b"
 #: booleans, "i" integers; integers may stand for floats)
@@ -205,7 +167,7 @@ def load_solution(folder, problem=None):
     names += ("stress_zz_last",) if problem.dim == 2 else ()
     run = document["run"]
     levels = run.get("levels") if isinstance(run, dict) else None
-    if not isinstance(run, dict) or run.get("status") not in STATUS or \
+    if not isinstance(run, dict) or run.get("status") not in STATUS_CODES or \
             not isinstance(levels, int) or isinstance(levels, bool) or levels < 0:
         raise OutputFolderError(summary_path, "its run record is damaged (run.status, "
                                 "run.levels); run the scene again")
@@ -216,7 +178,7 @@ def load_solution(folder, problem=None):
     if problem.scene.adaptive is not None and problem.times.size != arrays["t"].size:
         problem = on_levels(problem, arrays["t"])
     return Solution(
-        problem=problem, status=STATUS[run["status"]], message=run["message"], failure=None,
+        problem=problem, status=STATUS_CODES[run["status"]], message=run["message"], failure=None,
         t=arrays["t"], u=arrays["u"], beta=arrays["beta"],
         stress=arrays["stress_last"][None], stress_zz=None if zz is None else zz[None],
         contact_force=arrays["contact_force"],

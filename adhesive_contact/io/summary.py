@@ -1,11 +1,23 @@
-"""The JSON records of ``summary.json``: the smallness terms and one record
-per time level. The quantities come from :mod:`adhesive_contact.postprocess`;
-this module only formats them.
+"""``summary.json``, written and read in one place (docs/outputs.md).
+
+:data:`SCHEMA` is the version of its layout and :data:`STATUS` the words
+of ``run.status``; :func:`summary_document` builds the document of a
+solution (the resolved scene, mesh counts, how the run ended, the
+smallness terms, warnings, timings, the linear backend, the estimated
+resources beside those used, iterations and one record per time level,
+:func:`step_records`), :func:`write_summary` writes it (strict JSON: no
+NaN or infinity) and :func:`read_summary` reads one back, checking its
+layout. The quantities come from :mod:`adhesive_contact.postprocess`; this
+module only formats them.
 """
+
+import json
+import resource
+from pathlib import Path
 
 import numpy as np
 
-from adhesive_contact.postprocess import (
+from ..postprocess import (
     beta_mean,
     contact_measure,
     contact_state_counts,
@@ -19,7 +31,122 @@ from adhesive_contact.postprocess import (
     reactions,
     total_contact_force,
 )
-from adhesive_contact.storage import json_number
+from ..problem.warnings import solution_warnings
+from ..resources import estimate
+from ..scheme import STEP_FAILED, STOPPED, SUCCESS
+from ..storage import json_number, write_json
+from .errors import OutputFolderError
+
+#: the version of summary.json's layout (docs/outputs.md): raised when a key
+#: changes meaning or goes; new keys do not change it
+SCHEMA = 2
+
+#: Solution.status -> summary.json's run.status
+STATUS = {SUCCESS: "complete", STEP_FAILED: "step failed", STOPPED: "interrupted"}
+#: summary.json's run.status -> Solution.status
+STATUS_CODES = {word: code for code, word in STATUS.items()}
+
+
+def summary_document(solution, source=None, history=None, lines=None):
+    """The ``summary.json`` document (a dict of plain JSON types).
+
+    ``source``: ``{"text", "folder"}``, the scene's TOML text and the
+    absolute folder its relative paths are taken in (None: the working
+    directory), from which :func:`adhesive_contact.io.load_solution`
+    rebuilds the problem. ``lines``: the run's
+    :func:`~adhesive_contact.problem.warnings.solution_warnings`, when the
+    caller has them already (they read every level's gradients)."""
+    problem = solution.problem
+    if lines is None:
+        lines = solution_warnings(solution)
+    mesh, boundary = problem.mesh, problem.boundary
+    return {
+        "schema": SCHEMA,
+        "scene": problem.scene.resolved,
+        **({"source": source} if source is not None else {}),
+        "mesh": {
+            "nodes": int(mesh.p.shape[1]),
+            "cells": int(mesh.t.shape[1]),
+            "dofs": int(problem.ndofs),
+            "free_dofs": int(problem.free.size),
+            "contact_facets": 0 if boundary is None else int(boundary.facets.size),
+            "contact_nodes": 0 if boundary is None else int(boundary.nodes.size),
+        },
+        "run": run_record(solution),
+        "smallness": smallness_record(problem),
+        "warnings": [str(w) for w in problem.warnings()] + list(lines),
+        "timings": {key: json_number(value) for key, value in solution.timings.items()},
+        "linear": dict(solution.linear),
+        **({"adaptive": {key: json_number(v) if isinstance(v, float) else v
+                         for key, v in solution.adaptive.items()}}
+           if solution.adaptive is not None else {}),
+        "resources": resources_record(solution),
+        "iterations": [int(i) for i in solution.iterations],
+        "energy": energy_record(solution),
+        "steps": step_records(solution, history),
+    }
+
+
+def resources_record(solution):
+    """The estimate made from the scene before the run
+    (:func:`adhesive_contact.resources.estimate`) beside what was used."""
+    problem = solution.problem
+    return {
+        "estimate": estimate(problem.scene).record(),
+        "used": {"dofs": int(problem.ndofs), "contact_unknowns": int(problem.columns.size),
+                 "levels": int(solution.t.size), "backend": solution.linear.get("method"),
+                 "seconds": json_number(solution.timings.get("total", float("nan"))),
+                 "peak_memory_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+                 * 1024},
+    }
+
+
+def run_record(solution):
+    """How the run ended: ``{"success", "status", "partial", "levels",
+    "message", "failed_step", "failed_t"}``. ``status`` is "complete", "step
+    failed" or "interrupted"; a partial run holds ``levels`` = M + 1 < N + 1
+    time levels, those before the failure or the interruption."""
+    failure = solution.failure
+    return {
+        "success": bool(solution.success),
+        "status": STATUS[solution.status],
+        "partial": bool(solution.t.size < solution.problem.times.size
+                        if solution.adaptive is None else not solution.success),
+        "levels": int(solution.t.size),
+        "message": " ".join(solution.message.split()),
+        "failed_step": None if failure is None else int(failure.n),
+        "failed_t": None if failure is None else json_number(failure.t),
+    }
+
+
+def write_summary(solution, path, source=None, history=None, lines=None):
+    """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
+    write_json(path, summary_document(solution, source, history, lines))
+
+
+def read_summary(path):
+    """The ``summary.json`` document at ``path``, of this layout (schema :data:`SCHEMA`)."""
+    try:
+        document = json.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise OutputFolderError(path, "no such file; an output folder of 'adhcontact solve' "
+                                "has one (docs/outputs.md)") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise OutputFolderError(path, f"cannot be read: {err}") from None
+    except json.JSONDecodeError as err:
+        raise OutputFolderError(path, f"not valid JSON ({err}): the file is damaged; run "
+                                "the scene again") from None
+    except RecursionError:
+        raise OutputFolderError(path, "is nested too deeply to be a summary.json: the file "
+                                "is damaged; run the scene again") from None
+    if not isinstance(document, dict) or document.get("schema") != SCHEMA:
+        found = document.get("schema") if isinstance(document, dict) else None
+        raise OutputFolderError(path, f"has schema {found!r}; this version reads schema "
+                                f"{SCHEMA}: run the scene again with it")
+    for key in ("scene", "run", "steps"):
+        if key not in document:
+            raise OutputFolderError(path, f"has no {key!r}: the file is damaged")
+    return document
 
 
 def _vector(values):
