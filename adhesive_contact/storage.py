@@ -9,11 +9,13 @@ turns numpy scalars and containers into JSON types with NaN and ±inf as
 """
 
 import contextlib
+import csv
 import json
 import math
 import os
 import re
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -149,14 +151,34 @@ def saved_or_computed(path, compute):
     return record
 
 
-def write_csv(path, header, rows, digits=10):
-    """A CSV table written atomically: the ``header`` row, then ``rows``
-    (sequences of values; floats to ``digits`` significant digits)."""
-    lines = [",".join(header)] + [
-        ",".join(f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row)
-        for row in rows]
-    text = "\n".join(lines) + "\n"
-    write_atomic(path, lambda f: f.write(text))
+def csv_cell(value, digits=None):
+    """A value as a cell of the package's CSV files: a float as ``repr``
+    (it reads back to the same float) or to ``digits`` significant digits
+    when given, None (and a NaN) as an empty cell, a list or table as its
+    text."""
+    if value is None:
+        return ""
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        if value != value:
+            return ""
+        return repr(value) if digits is None else f"{value:.{digits}g}"
+    if isinstance(value, np.integer):
+        return str(int(value))
+    return str(value)
+
+
+def write_csv(path, columns, rows, digits=None):
+    """A CSV table written atomically: a header of ``columns``, then one
+    line per row (a sequence of cells in column order, or a mapping by
+    column name), each cell :func:`csv_cell` (floats exact by default)."""
+    def write(f):
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(columns)
+        for row in rows:
+            cells = [row.get(c) for c in columns] if isinstance(row, Mapping) else row
+            writer.writerow([csv_cell(v, digits) for v in cells])
+    write_atomic(path, write)
 
 
 def toml_value(value):

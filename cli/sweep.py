@@ -14,14 +14,13 @@ import click
 
 from adhesive_contact import SceneError, scene_from_dict
 from adhesive_contact.storage import toml_value
-from adhesive_contact.studies import (
-    Sweep,
-    parse_assignment,
-)
+from adhesive_contact.studies import Sweep
 from adhesive_contact.studies.sweep import LOST, variant_document, variants
 from adhesive_contact.visuals import write_sweep_plots
 
+from .assignments import AssignmentError, parse_assignment
 from .common import (
+    CliError,
     check_out,
     guard,
     load_scene,
@@ -116,8 +115,12 @@ def sweep(scene, assignments, grid, jobs, scheduler, out, force):
     load_scene(text, scene_folder(scene), force)
     out = Path(out) if out is not None else Path.cwd() / f"{name}-sweep"
     check_out(out)
-    def make():
+    try:
         settings = [parse_assignment(a) for a in assignments]
+    except AssignmentError as err:
+        raise CliError(f"--{err}", 2) from None
+
+    def make():
         source = study_source(text, scene_folder(scene))
         guard_variants(source, settings, grid, force, scene_folder(scene))
         return Sweep(source, settings, "grid" if grid else "zip", folder=out,

@@ -6,7 +6,7 @@ under faults (a SIGKILL at a drawn file move, a drawn file-size limit) and
 tampered output folders.
 
 Each property is what the command line promises: a bad input is a
-:class:`~adhesive_contact.SceneError` (or StudyError, ClusterError,
+:class:`~adhesive_contact.SceneError` (or AssignmentError, ClusterError,
 OutputFolderError: one line naming the key, the file or the address),
 never another exception, a hang or a quiet wrong result; what is accepted
 is usable (finite where the scheme reads it). The number of examples per
@@ -33,7 +33,8 @@ from hypothesis import strategies as st
 from adhesive_contact import OutputFolderError, SceneError, build_problem, load_solution
 from adhesive_contact import scene_from_dict
 from adhesive_contact.folders import MARKER, recover
-from adhesive_contact.studies import ClusterError, StudyError, dask_executor, parse_assignment
+from adhesive_contact.studies import ClusterError, dask_executor
+from adhesive_contact_cli.assignments import AssignmentError, parse_assignment
 from adhesive_contact_cli.main import main
 
 #: examples per surface (a few minutes in all)
@@ -209,7 +210,7 @@ def test_fuzz_set_values(text):
     started = time.perf_counter()
     try:
         key, values = parse_assignment(text)
-    except StudyError as err:
+    except AssignmentError as err:
         one_line(err)
     else:
         assert key and values

@@ -20,8 +20,9 @@ from adhesive_contact import (
     solve,
 )
 from adhesive_contact.postprocess import beta_mean, energies, reactions
-from adhesive_contact.studies import StudyError, Sweep, parse_assignment
-from adhesive_contact.studies.sweep import split_values, variants, with_value
+from adhesive_contact.studies import StudyError, Sweep
+from adhesive_contact.studies.sweep import variants, with_value
+from adhesive_contact_cli.assignments import AssignmentError, parse_assignment, split_values
 
 # an 8x4 block hanging from its top, pulled down onto a wall: with one
 # Newton iteration allowed, the stiff layer (c = 5000) fails at step 1
@@ -85,9 +86,9 @@ def test_values_are_toml_scalars_split_outside_brackets():
         ("contact.quadrature", ["nodal", "gauss"])
     assert parse_assignment("x.flag=true,false")[1] == [True, False]
     assert split_values('"a,b",[1,2]') == ['"a,b"', "[1,2]"]
-    with pytest.raises(StudyError, match="expected KEY=V1,V2"):
+    with pytest.raises(AssignmentError, match="expected KEY=V1,V2"):
         parse_assignment("contact.normal.c")
-    with pytest.raises(StudyError, match="'1x' is not a TOML value") as err:
+    with pytest.raises(AssignmentError, match="'1x' is not a TOML value") as err:
         parse_assignment("time.steps=10,1x")
     assert err.value.key == "set time.steps"
 
@@ -371,7 +372,7 @@ def test_each_value_is_checked_once_and_a_bad_combination_is_a_failed_row(tmp_pa
 
 def test_a_value_nested_too_deeply_is_one_line():
     # --set title=[[[...]]] 3000 deep was a RecursionError (2,999 lines)
-    with pytest.raises(StudyError, match=r"^set title: a value nested 3000 deep \(at most 16 "
+    with pytest.raises(AssignmentError, match=r"^set title: a value nested 3000 deep \(at most 16 "
                                          r"levels of brackets\)$"):
         parse_assignment("title=" + "[" * 3000 + "]" * 3000)
     assert parse_assignment('title="' + "[" * 40 + '"') == ("title", ["[" * 40])

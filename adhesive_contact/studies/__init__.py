@@ -20,9 +20,9 @@ from .study import (
     StudyMismatch,
     study_document,
 )
-from .sweep import Sweep, SweepResult, parse_assignment
+from .sweep import Sweep, SweepResult
 
 __all__ = ["ClusterError", "ConvergenceResult", "ConvergenceStudy", "DaskExecutor",
            "dask_executor", "execute", "RunFailed", "RunStore",
            "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document",
-           "Sweep", "SweepResult", "parse_assignment"]
+           "Sweep", "SweepResult"]

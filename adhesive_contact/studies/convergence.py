@@ -32,7 +32,6 @@ From Python::
     result.document["rates"]     # {"u": ..., "beta": ..., "E": ...}
 """
 
-import csv
 import json
 import math
 import zipfile
@@ -58,7 +57,7 @@ from ..verification.levels import (
 from ..fem.meshes import build_mesh
 from ..scene import SceneError, scene_from_dict
 from ..scene.materials import check_relaxation_step
-from ..storage import write_atomic, write_json
+from ..storage import write_atomic, write_csv, write_json
 from .pool import attempt, in_this_process
 from .study import RunFailed, Study, StudyError, scene_identity, scene_source
 
@@ -236,22 +235,12 @@ def csv_columns(document):
     return CSV_COLUMNS + (QUANTITY_COLUMNS if "quantity" in document else ())
 
 
-def error_rows(document):
-    """The rows of ``errors.csv`` (:func:`csv_columns`), one per level: floats
-    as repr, None (a rate_E on the first level, a NaN, a relative error of
-    a zero solution or of a level saved without it) as an empty cell."""
-    return [["" if row[key] is None else
-             (repr(float(row[key])) if isinstance(row[key], float) else row[key])
-             for key in csv_columns(document)] for row in document["levels"]]
-
-
 def write_errors_csv(path, document):
-    """``errors.csv``: a header of :func:`csv_columns`, then :func:`error_rows`."""
-    def write(f):
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(csv_columns(document))
-        writer.writerows(error_rows(document))
-    write_atomic(path, write)
+    """``errors.csv``: a header of :func:`csv_columns`, then one row per
+    level (:func:`adhesive_contact.storage.write_csv`: None — a rate_E on
+    the first level, a relative error of a zero solution or of a level
+    saved without it — an empty cell)."""
+    write_csv(path, csv_columns(document), document["levels"])
 
 
 # ---------------------------------------------------------------- in a worker

@@ -30,21 +30,18 @@ From Python::
 """
 
 import copy
-import csv
 import hashlib
 import math
 import itertools
-import re
 import resource
 import time
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from .. import SceneError, build_problem, scene_from_dict, solve
 from ..postprocess.scalars import scalar_quantities, state_quantities
 from ..problem.warnings import solution_warnings
-from ..storage import plain, toml_value, write_atomic
+from ..storage import plain, toml_value, write_csv
 from .study import Study, StudyError, scene_identity, scene_source
 
 MODES = ("grid", "zip")
@@ -59,79 +56,9 @@ MEASURED = ("outcome", "failed_step", "failed_t", "residual", "seconds", "newton
             "newton_max", "worker_peak_rss_mib", "beta_min_T", "beta_mean_T",
             "max_un_minus_g", "separated_T", "on_wall_T", "compliance_T", "stick_T",
             "slip_T", "normal_force_T")
-#: the deepest nesting of brackets in a value given to --set
-MAX_VALUE_DEPTH = 16
-_BARE = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
 
 # ---------------------------------------------------------------- settings
-
-
-def split_values(text):
-    """Split ``"1e2,1e3"`` at the commas outside brackets and quotes."""
-    parts, depth, quote, start = [], 0, None, 0
-    for i, ch in enumerate(text):
-        if quote:
-            if ch == quote:
-                quote = None
-        elif ch in "\"'":
-            quote = ch
-        elif ch in "[{":
-            depth += 1
-        elif ch in "]}":
-            depth -= 1
-        elif ch == "," and depth == 0:
-            parts.append(text[start:i])
-            start = i + 1
-    parts.append(text[start:])
-    return [p.strip() for p in parts]
-
-
-def parse_value(text):
-    """A TOML value (``1e3``, ``10``, ``true``, ``"gauss"``, ``[8, 4]``); a bare
-    word that is not TOML (``gauss``) is taken as a string.
-
-    Raises ValueError naming the text when it is neither."""
-    depth = level = 0
-    quote = None
-    for char in text:   # before the parser, which recurses per bracket
-        if quote:
-            quote = None if char == quote else quote
-        elif char in "\"'":
-            quote = char
-        else:
-            level += (char in "[{") - (char in "]}")
-            depth = max(depth, level)
-    if depth > MAX_VALUE_DEPTH:
-        raise ValueError(f"a value nested {depth} deep (at most {MAX_VALUE_DEPTH} levels of "
-                         "brackets)")
-    try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
-        if _BARE.fullmatch(text):
-            return text
-        raise ValueError(f"{text!r} is not a TOML value (a number, true/false, "
-                         "a quoted string or an array)") from None
-
-
-def parse_assignment(text):
-    """``"KEY=V1,V2,..."`` -> (key, [values]) with TOML values (:func:`parse_value`).
-
-    Raises :class:`StudyError` (key ``"set"``, or the key) for a malformed one."""
-    key, sep, values = text.partition("=")
-    key = key.strip()
-    if not sep or not key or not values.strip():
-        raise StudyError("set", f"{text!r}: expected KEY=V1,V2,... (a dotted TOML key, "
-                         "comma-separated values)")
-    if not all(part for part in key.split(".")):
-        raise StudyError("set", f"{key!r}: empty part in the dotted key")
-    parsed = []
-    for item in split_values(values):
-        try:
-            parsed.append(parse_value(item))
-        except ValueError as err:
-            raise StudyError(f"set {key}", str(err)) from None
-    return key, parsed
 
 
 def with_value(document, key, value):
@@ -338,26 +265,10 @@ def run_row(record, keys, quantities=()):
     return row
 
 
-def _cell(value):
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return repr(value)
-    if isinstance(value, (list, dict)):
-        return str(value)
-    return value
-
-
 def write_runs_csv(path, rows, keys, quantities=()):
-    """``runs.csv``: a header of :func:`csv_columns`, one row per run; None empty."""
-    columns = csv_columns(keys, quantities)
-
-    def write(f):
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(columns)
-        for row in rows:
-            writer.writerow([_cell(row[column]) for column in columns])
-    write_atomic(path, write)
+    """``runs.csv``: a header of :func:`csv_columns`, one row per run
+    (:func:`adhesive_contact.storage.write_csv`; None an empty cell)."""
+    write_csv(path, csv_columns(keys, quantities), rows)
 
 
 # ---------------------------------------------------------------- the study
