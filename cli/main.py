@@ -261,7 +261,8 @@ def solve_command(scene, out, force, quiet):
                     for warning in lines:
                         if not quiet:
                             click.echo(f"warning: {warning}", err=True)
-                    files = write_results(solution, folder, failures, source, lines)
+                    files = write_results(solution, folder, failures, source, lines,
+                                          field_levels=recorder.field_levels())
             finally:
                 recorder.close()
             files = sorted(files + recorder.names) if files else []

@@ -25,14 +25,15 @@ SCENE = to_toml(BLOCK)
 NPOINTS, NCELLS, NFACETS, NLEVELS = 45, 64, 8, 4
 STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "beta_min",
              "separated", "on_wall", "stick", "slip", "contact_measure", "max_penetration",
-             "iterations", "residual", "reactions", "contact_force", "energy", "debonding"}
+             "iterations", "residual", "reactions", "contact_force", "energy", "debonding",
+             "peak_pressure", "peak_pressure_at", "stick_measure", "slip_measure"}
 SUMMARY_KEYS = {"schema", "scene", "source", "mesh", "run", "smallness", "warnings", "timings",
-                "linear", "resources", "iterations", "energy", "steps"}
+                "linear", "resources", "output", "iterations", "energy", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
                   "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",
                   "trace_lower_estimate",
                   "nonconvexity", "step_energy_convex"}
-FILES = {"summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
+FILES = {"summary.json", "scalars.csv", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
          "contact.h5", "deformed.png", "contact_traction.png", "beta.png"}
 
 
@@ -82,7 +83,8 @@ def test_npz_has_the_firm_keys_and_shapes(solved):
                                    "reactions", "reaction_sides", "contact_nodes",
                                    "contact_points", "contact_pressure"} | {
             "contact_force", "frame_displacement", "on_wall", "stuck", "probes", "iterations",
-            "residual", "held_reaction", "stress_last", "stress_zz_last"}
+            "residual", "held_reaction", "stress_last", "stress_zz_last", "u_levels",
+            "scalar_names", "scalar_kinds", "scalar_values"}
         assert data["stress_last"].shape == (NCELLS, 2, 2)
         assert data["stress_zz_last"].shape == (NCELLS,)
         assert list(data["reaction_sides"]) == ["top"]
@@ -276,7 +278,7 @@ def test_stale_outputs_of_a_previous_run_are_removed(tmp_path):
     (tmp_path / "free.toml").write_text(no_contact)
     result = run("solve", tmp_path / "free.toml", "--out", out)
     assert result.exit_code == 0, result.stderr
-    assert set(p.name for p in out.iterdir()) == {"summary.json", "solution.npz",
+    assert set(p.name for p in out.iterdir()) == {"summary.json", "scalars.csv", "solution.npz",
                                                   "solution.xdmf", "solution.h5",
                                                   "deformed.png"}
 

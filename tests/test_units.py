@@ -236,6 +236,24 @@ def test_converge_names_the_unit_of_h(tmp_path, monkeypatch):
     assert visuals.figure_error_vs_size(k_study, "t", visuals.Units(UNITS)).axes[0] \
         .get_xlabel() == "time step k (s)"
     assert visuals.figure_error_vs_size(k_study, "t").axes[0].get_xlabel() == "time step k"
+    header = (tmp_path / "c" / "errors.csv").read_text().splitlines()[0].split(",")
+    assert header[:3] == ["level", "h [mm]", "k [s]"] and "E" in header
+
+
+def test_a_quantity_study_names_its_unit(tmp_path, monkeypatch):
+    """converge --quantity: errors.csv's Q and |Q − Q_ref| columns and the
+    plot's axes carry the quantity's unit (a reaction in 2D: N/mm)."""
+    scene = tmp_path / "block.toml"
+    scene.write_text(to_toml(scene_dict({"output.units": UNITS, "mesh.cells": [4, 2],
+                                         "time.steps": 2}, wall_block())))
+    made = capture(monkeypatch, study_figures, "figure_quantity_vs_size")
+    result = run("converge", scene, "--param", "h", "--levels", "2", "--ref-h", "1",
+                 "--quantity", "normal_force_T", "--out", tmp_path / "q")
+    assert result.exit_code == 0, result.stderr
+    header = (tmp_path / "q" / "errors.csv").read_text().splitlines()[0].split(",")
+    assert "quantity [N/mm]" in header and "err_q [N/mm]" in header and "rel_q" in header
+    assert made[0].axes[0].get_ylabel() == "normal_force_T (N/mm)"
+    assert made[0].axes[1].get_ylabel() == "|Q_h − Q_ref| of normal_force_T (N/mm)"
 
 
 def test_sweep_names_the_unit_of_the_force(tmp_path, monkeypatch):
@@ -247,6 +265,9 @@ def test_sweep_names_the_unit_of_the_force(tmp_path, monkeypatch):
     assert result.exit_code == 0, result.stderr
     force = [ax.get_ylabel() for ax in made[0].axes if "normal contact force" in ax.get_ylabel()]
     assert force == ["total normal contact force at T\n(> 0 compression; N/mm)"]
+    header = (tmp_path / "s" / "runs.csv").read_text().splitlines()[0].split(",")
+    assert "normal_force_T [N/mm]" in header and "beta_mean_T" in header
+    assert "contact.normal.c" in header and "outcome" in header
     rows = [{"outcome": "ok", "k": 1.0, "normal_force_T": 1.0, "seconds": 1.0,
              "newton_total": 1, "beta_mean_T": 1.0}]
     plain = visuals.figure_by_key(rows, ["k"], "k", "t")

@@ -39,3 +39,22 @@ def test_hertz_half_width_and_peak_pressure_on_the_coarse_mesh(geometry):
         y = problem.mesh.p[1, problem.boundary.nodes] + solution.u[:, problem.boundary.nodes, 1]
         assert y.min() > -1e-13
     assert np.isfinite(solution.u).all()
+
+
+@pytest.mark.parametrize("geometry", hertz.GEOMETRIES)
+def test_the_built_in_contact_metrics_meet_hertz(geometry):
+    """scalars.csv's contact metrics against the closed form on the coarse
+    mesh: the peak pressure p0 within the 1 % the profile meets, at the
+    node on the axis; the contact width of the half model, Σ w_a over the
+    nodes in contact, within one cell h_c of Hertz's half-width a."""
+    from adhesive_contact.postprocess.level_scalars import level_scalars
+
+    problem = build_problem(hertz.scene(geometry, 0))
+    solution = solve(problem, raise_on_failure=True)
+    columns = {c.name: c.values for c in level_scalars(solution)}
+    for n in (5, 8):
+        r = hertz.measure(problem, solution, n)
+        assert abs(columns["peak_pressure"][n] / r["p0_hertz"] - 1) < 0.01
+        assert abs(columns["peak_pressure_x"][n]) < 1e-12
+        assert abs(columns["contact_width"][n] - r["a_hertz"]) < hertz.H_C[0]
+        assert columns["normal_force"][n] == pytest.approx(r["P"] / 2, rel=1e-12)

@@ -10,6 +10,7 @@ A run streams its levels there as they are computed
 rest:
 
 - ``summary.json`` (:mod:`.summary`);
+- ``scalars.csv``: one row per level (:mod:`.scalars`);
 - ``solution.npz``: points, cells, contact_facets, t, u, beta (firm keys; :mod:`.npz`);
 - ``solution.xdmf`` + ``solution.h5`` and ``contact.xdmf`` + ``contact.h5``
   (:mod:`.xdmf`), written by the recorder;
@@ -21,16 +22,19 @@ from pathlib import Path
 
 from ..folders import FolderLock, staged_folder
 from ..postprocess import energies
+from ..postprocess.level_scalars import level_scalars
 from ..scheme import SUCCESS
 from ..storage import read_json
 from ..threads import one_blas_thread
+from .field_levels import field_levels
 from .npz import write_npz
+from .scalars import write_scalars_csv
 from .summary import STATUS, write_summary
 from .xdmf import write_xdmf
 
 #: the data files a run may write (the figures are :func:`output_names`')
-DATA_NAMES = ("summary.json", "solution.npz", "solution.xdmf", "solution.h5", "contact.xdmf",
-              "contact.h5")
+DATA_NAMES = ("summary.json", "scalars.csv", "solution.npz", "solution.xdmf", "solution.h5",
+              "contact.xdmf", "contact.h5")
 
 
 def output_names():
@@ -73,30 +77,40 @@ def staged_output(out):
         yield tmp
 
 
-def write_results(solution, folder, failures=None, source=None, lines=None):
-    """Write summary.json, solution.npz and the plots of a solution into
-    ``folder`` (the XDMF series are the recorder's); return their names. A
-    plot that cannot be drawn is left out and named in ``failures`` (a
-    list), if given; the data files are written all the same. ``source``:
-    the scene's text and folder, ``lines`` the run's warnings if known
+def write_results(solution, folder, failures=None, source=None, lines=None,
+                  field_levels=None):
+    """Write summary.json, scalars.csv, solution.npz and the plots of a
+    solution into ``folder`` (the XDMF series are the recorder's); return
+    their names. ``field_levels``: the levels whose fields are written
+    (:mod:`.field_levels`; default every level). A plot that cannot be
+    drawn is left out and named in ``failures`` (a list), if given; the
+    data files are written all the same. ``source``: the scene's text and
+    folder, ``lines`` the run's warnings if known
     (:func:`~.summary.summary_document`)."""
     from ..visuals import write_plots   # matplotlib: imported when a run draws
 
     folder = Path(folder)
     with one_blas_thread():   # level-sized products (adhesive_contact.threads)
-        history = energies(solution)   # once, for summary.json and the figures
-        write_summary(solution, folder / "summary.json", source, history, lines)
-        write_npz(solution, folder / "solution.npz")
-        return ["summary.json", "solution.npz"] + write_plots(solution, folder, failures,
-                                                               history)
+        history = energies(solution)   # once, for every file and figure
+        columns = level_scalars(solution, history)
+        write_summary(solution, folder / "summary.json", source, history, lines,
+                      field_levels, columns)
+        write_scalars_csv(folder / "scalars.csv", solution.problem, columns)
+        write_npz(solution, folder / "solution.npz", field_levels, columns)
+        return ["summary.json", "scalars.csv", "solution.npz"] + write_plots(
+            solution, folder, failures, history)
 
 
 def write_outputs(solution, out, failures=None, source=None):
     """Write all outputs of a finished in-memory solution into ``out`` as
-    ``adhcontact solve`` does (its lock held, staged, published whole);
-    return the names of the files written. A folder another process is
-    writing raises :class:`adhesive_contact.folders.FolderLocked`."""
+    ``adhcontact solve`` does (its lock held, staged, published whole; the
+    fields at the field levels of its scene's ``[output]``); return the
+    names of the files written. A folder another process is writing raises
+    :class:`adhesive_contact.folders.FolderLocked`."""
+    problem = solution.problem
+    every = problem.output.every if problem.output is not None else 1
+    levels = field_levels(problem, solution.reaction, solution.contact_force, every)
     with FolderLock(out), staged_output(out) as tmp:
-        names = sorted(write_xdmf(solution, tmp)
-                       + write_results(solution, tmp, failures, source))
+        names = sorted(write_xdmf(solution, tmp, levels)
+                       + write_results(solution, tmp, failures, source, field_levels=levels))
     return names

@@ -24,7 +24,8 @@ from .summary import STATUS_CODES, read_summary
 
 #: the kinds of numpy dtype each kind of array may have ("f" floats, "b"
 #: booleans, "i" integers; integers may stand for floats)
-KINDS = {"f": "fiu", "b": "b", "i": "iu"}
+KINDS = {"f": "fiu", "b": "b", "i": "iu", "U": "U"}
+KIND_NAMES = {"f": "float", "b": "bool", "i": "int", "U": "str"}
 
 
 def array_headers(path, names):
@@ -61,7 +62,7 @@ def read_arrays(path, names, expected=None):
             found, dtype = headers[name]
             if dtype.kind not in KINDS[kind] or dtype.hasobject:
                 raise OutputFolderError(path, f"holds {name!r} of dtype {dtype}, not "
-                                        f"{ {'f': 'float', 'b': 'bool', 'i': 'int'}[kind]}: "
+                                        f"{KIND_NAMES[kind]}: "
                                         "the file is damaged; run the scene again")
             if found != shape:
                 raise OutputFolderError(path, f"holds {name!r} of shape {found}, not {shape} "
@@ -103,16 +104,18 @@ def _differing_key(a, b, prefix=""):
     return None if a == b else prefix.rstrip(".") or "scene"
 
 
-def expected_arrays(problem, levels):
+def expected_arrays(problem, levels, with_fields=None):
     """{name: (shape, kind)} of the arrays of solution.npz for ``problem``
-    and a run of ``levels`` time levels (:func:`read_arrays`)."""
+    and a run of ``levels`` time levels (:func:`read_arrays`), u at
+    ``with_fields`` levels of them (default: every one)."""
     mesh, boundary, d = problem.mesh, problem.boundary, problem.dim
     npoints, ncells = mesh.p.shape[1], mesh.t.shape[1]
     nc = 0 if boundary is None else boundary.nodes.size
     nf = 0 if boundary is None else boundary.facets.size
     nprobes = 0 if problem.probe_map is None else problem.probe_map.shape[0]
     L = levels
-    shapes = {"points": ((npoints, d), "f"), "t": ((L,), "f"), "u": ((L, npoints, d), "f"),
+    held = L if with_fields is None else with_fields
+    shapes = {"points": ((npoints, d), "f"), "t": ((L,), "f"), "u": ((held, npoints, d), "f"),
               "beta": ((L, nf), "f"), "contact_force": ((L, nc, d), "f"),
               "frame_displacement": ((L, nc, d), "f"), "on_wall": ((L, nc), "b"),
               "stuck": ((L, nc), "b"), "probes": ((L, nprobes, d), "f"),
@@ -171,7 +174,9 @@ def load_solution(folder, problem=None):
             not isinstance(levels, int) or isinstance(levels, bool) or levels < 0:
         raise OutputFolderError(summary_path, "its run record is damaged (run.status, "
                                 "run.levels); run the scene again")
-    arrays = read_arrays(npz_path, names, expected_arrays(problem, levels))
+    field_levels, scalars = _fields_and_scalars(npz_path, levels)
+    arrays = read_arrays(npz_path, names, expected_arrays(
+        problem, levels, None if field_levels is None else field_levels.size))
     if not np.array_equal(arrays["points"], problem.mesh.p.T):
         raise OutputFolderError(npz_path, "holds another mesh than the problem's")
     zz = arrays.get("stress_zz_last")
@@ -187,7 +192,55 @@ def load_solution(folder, problem=None):
         residual=arrays["residual"], reaction=arrays["held_reaction"],
         timings={k: (float("nan") if v is None else v)
                  for k, v in document.get("timings", {}).items()},
-        linear=dict(document.get("linear", {})), adaptive=document.get("adaptive"))
+        linear=dict(document.get("linear", {})), adaptive=document.get("adaptive"),
+        field_levels=field_levels, scalars=scalars)
+
+
+#: the optional arrays of solution.npz: the levels with fields and the
+#: scalars of every level (written since [output] every)
+OPTIONAL = ("u_levels", "scalar_names", "scalar_kinds", "scalar_values")
+
+
+def _fields_and_scalars(path, levels):
+    """(field levels, scalars) of solution.npz at ``path`` for a run of
+    ``levels`` levels: the levels whose u it holds (None: every level) and
+    {name: (kind, values)} of its scalars (None when not recorded)."""
+    headers = array_headers_or_error(path, OPTIONAL)
+    if "u_levels" not in headers:
+        return None, None
+    count = headers["u_levels"][0]
+    names = headers.get("scalar_names", ((0,), None))[0]
+    expected = {"u_levels": (count, "i")}
+    if "scalar_values" in headers:
+        expected.update(scalar_names=(names, "U"), scalar_kinds=(names, "U"),
+                        scalar_values=((levels, *names), "f"))
+    arrays = read_arrays(path, tuple(expected), expected)
+    field_levels = np.asarray(arrays["u_levels"], dtype=np.int64)
+    if field_levels.size and (np.any(np.diff(field_levels) <= 0) or field_levels[0] < 0
+                              or field_levels[-1] >= levels):
+        raise OutputFolderError(path, f"holds 'u_levels' that are not increasing levels "
+                                f"of the run's {levels}: the file is damaged; run the scene "
+                                "again")
+    if field_levels.size == levels:
+        field_levels = None   # every level
+    scalars = None
+    if "scalar_values" in arrays:
+        values = arrays["scalar_values"]
+        scalars = {str(name): (str(kind), values[:, i]) for i, (name, kind) in
+                   enumerate(zip(arrays["scalar_names"], arrays["scalar_kinds"]))}
+    return field_levels, scalars
+
+
+def array_headers_or_error(path, names):
+    """:func:`array_headers`, a file that cannot be read an OutputFolderError."""
+    try:
+        return array_headers(path, names)
+    except FileNotFoundError:
+        raise OutputFolderError(path, "no such file; an output folder of 'adhcontact solve' "
+                                "has one (docs/outputs.md)") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
+        raise OutputFolderError(path, f"cannot be read ({type(err).__name__}: {err}): the "
+                                "file is damaged; run the scene again") from None
 
 
 def on_levels(problem, t):

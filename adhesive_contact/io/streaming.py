@@ -1,13 +1,18 @@
 """A recorder that streams the levels of a run to its files.
 
-:class:`StreamingRecorder` writes each level to the XDMF time series
-(:class:`~adhesive_contact.io.xdmf.XdmfSeries`) and u_n to a scratch HDF5
-file as soon as it is computed. In memory it keeps per level only what is
+:class:`StreamingRecorder` writes u_n of every level to a scratch HDF5
+file as soon as it is computed, and the fields of the field levels
+(``[output] every`` and ``fields``, :mod:`.field_levels`) to the XDMF time
+series (:class:`~adhesive_contact.io.xdmf.XdmfSeries`): a level of the
+grid at once, a candidate peak when the run ends (it is kept in memory
+until a later level passes its peak; at most one level per reported
+force). In memory it keeps per level only what is
 small: β per contact facet, the contact force, frame displacement and
 states per contact node, the probes, the reactions per held dof, the
 iterations and residual; and the
 last level's u and σ. The Solution it builds reads u_n from the scratch
-file (:class:`DiskLevels`) and holds σ of the last level only.
+file (:class:`DiskLevels`) and holds σ of the last level only; its
+field levels are :meth:`StreamingRecorder.field_levels`.
 
 The memory of a run is then flat in the number of steps N, up to the
 O(N·n_Γ) contact history, and the memory kernel: a Prony series keeps
@@ -19,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..scheme.options import OutputOptions
+from .field_levels import FieldLevels, reported_forces
 from .h5 import H5File
 from .xdmf import XdmfSeries
 
@@ -57,9 +64,13 @@ class StreamingRecorder:
 
     def __init__(self, problem, folder):
         self.folder = Path(folder)
-        self.series = XdmfSeries(problem, self.folder)
+        self.problem = problem
+        output = problem.output if problem.output is not None else OutputOptions()
+        self.series = XdmfSeries(problem, self.folder, output.fields)
         self.names = list(self.series.names)
-        levels = problem.scene.steps + 1
+        self.chooser = FieldLevels(output.every)
+        self.candidates = {}   # level -> Level, kept until the run ends or it is passed
+        levels = problem.options.steps + 1
         npoints, d = problem.mesh.p.shape[1], problem.dim
         self.scratch = H5File(self.folder / SCRATCH, "w")   # a full disk raises (h5.py)
         self.u = self.scratch.file.create_dataset("u", (levels, npoints, d), dtype=float,
@@ -71,15 +82,31 @@ class StreamingRecorder:
         self.empty = _empty_shapes(problem)
 
     def record(self, level):
-        """Write level ``level.n`` and keep its small fields."""
-        self.series.write(level)
+        """Keep level ``level.n``'s small fields and u, and write its fields
+        if it is a field level of the grid (or keep it as a candidate peak)."""
         if level.n >= self.u.shape[0]:   # an adaptive run: more levels than N + 1
             self.u.resize(2 * self.u.shape[0], axis=0)
         self.u[level.n] = level.u
         for name in SMALL:
             self.small[name].append(np.asarray(getattr(level, name)))
+        write, keep, drop = self.chooser.offer(
+            level.n, reported_forces(self.problem, level.reaction, level.contact_force))
+        for n in drop:
+            self.candidates.pop(n, None)
+        if write:
+            self.series.write(level)
+        elif keep:
+            self.candidates[level.n] = level
         self.last = level
         self.count = level.n + 1
+
+    def field_levels(self):
+        """Write the field levels still pending (the last level and the
+        peaks off the grid) and return every field level, increasing."""
+        for n in self.chooser.end():
+            self.series.write(self.last if n == self.last.n else self.candidates[n])
+        self.candidates.clear()
+        return np.array(self.chooser.levels(), dtype=np.int64)
 
     def history(self):
         """The fields of a Solution: small ones as arrays, u read from disk,

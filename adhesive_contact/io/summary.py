@@ -31,6 +31,7 @@ from ..postprocess import (
     reactions,
     total_contact_force,
 )
+from ..postprocess.level_scalars import level_scalars
 from ..problem.warnings import solution_warnings
 from ..resources import estimate
 from ..scheme import STEP_FAILED, STOPPED, SUCCESS
@@ -47,7 +48,8 @@ STATUS = {SUCCESS: "complete", STEP_FAILED: "step failed", STOPPED: "interrupted
 STATUS_CODES = {word: code for code, word in STATUS.items()}
 
 
-def summary_document(solution, source=None, history=None, lines=None):
+def summary_document(solution, source=None, history=None, lines=None, field_levels=None,
+                     columns=None):
     """The ``summary.json`` document (a dict of plain JSON types).
 
     ``source``: ``{"text", "folder"}``, the scene's TOML text and the
@@ -55,7 +57,9 @@ def summary_document(solution, source=None, history=None, lines=None):
     directory), from which :func:`adhesive_contact.io.load_solution`
     rebuilds the problem. ``lines``: the run's
     :func:`~adhesive_contact.problem.warnings.solution_warnings`, when the
-    caller has them already (they read every level's gradients)."""
+    caller has them already (they read every level's gradients).
+    ``field_levels``: the levels whose fields were written (default every
+    level); ``columns`` the run's level scalars, when the caller has them."""
     problem = solution.problem
     if lines is None:
         lines = solution_warnings(solution)
@@ -81,10 +85,23 @@ def summary_document(solution, source=None, history=None, lines=None):
                          for key, v in solution.adaptive.items()}}
            if solution.adaptive is not None else {}),
         "resources": resources_record(solution),
+        "output": output_record(solution, field_levels),
         "iterations": [int(i) for i in solution.iterations],
         "energy": energy_record(solution),
-        "steps": step_records(solution, history),
+        "steps": step_records(solution, history, columns),
     }
+
+
+def output_record(solution, field_levels=None):
+    """What the run wrote: ``{"every", "fields", "field_levels"}``, the
+    levels whose fields are in the files (``[output]``,
+    :mod:`.field_levels`)."""
+    output = solution.problem.output
+    levels = (np.arange(solution.t.size) if field_levels is None
+              else np.asarray(field_levels))
+    return {"every": 1 if output is None else int(output.every),
+            "fields": [] if output is None else list(output.fields),
+            "field_levels": [int(n) for n in levels]}
 
 
 def resources_record(solution):
@@ -119,9 +136,12 @@ def run_record(solution):
     }
 
 
-def write_summary(solution, path, source=None, history=None, lines=None):
-    """Write ``summary.json`` (strict JSON: no NaN or infinity)."""
-    write_json(path, summary_document(solution, source, history, lines))
+def write_summary(solution, path, source=None, history=None, lines=None, field_levels=None,
+                  columns=None):
+    """Write ``summary.json`` (strict JSON: no NaN or infinity;
+    :func:`summary_document`)."""
+    write_json(path, summary_document(solution, source, history, lines, field_levels,
+                                      columns))
 
 
 def read_summary(path):
@@ -190,10 +210,12 @@ def _energy_at(history, n):
             "dissipated": dissipated, "balance": json_number(history.balance[n])}
 
 
-def _debonding_at(area, damage, per_area, per_damage, front, n):
-    """``steps[n].debonding``: the debonded area, the damage integral, the
-    glue's dissipation per unit of each, the front's points (2D)."""
+def _debonding_at(area, damage, new_area, new_damage, per_area, per_damage, front, n):
+    """``steps[n].debonding``: the debonded area and the damage integral
+    (pre-crack included), those of the run alone, the glue's dissipation
+    per unit of the latter, the front's points (2D)."""
     return {"area": json_number(area[n]), "damage": json_number(damage[n]),
+            "new_area": json_number(new_area[n]), "new_damage": json_number(new_damage[n]),
             "energy_per_area": json_number(per_area[n]) if per_area is not None else None,
             "energy_per_damage": (json_number(per_damage[n]) if per_damage is not None
                                   else None),
@@ -204,12 +226,14 @@ def _count(values, n):
     return None if values is None else int(values[n])
 
 
-def step_records(solution, history=None):
+def step_records(solution, history=None, columns=None):
     """The per-level entries of ``summary.json``'s ``steps`` list.
 
     Each is ``{"t", "probes", "normal_force", "tangential_force", "beta_mean",
     "beta_min", "separated", "on_wall", "stick", "slip", "contact_measure",
-    "max_penetration", "iterations", "residual"}``: normal_force is the total
+    "peak_pressure", "peak_pressure_at", "stick_measure", "slip_measure",
+    "max_penetration", "iterations", "residual", "reactions", "contact_force",
+    "energy", "debonding"}``: normal_force is the total
     force of Γ_C on the body, positive in compression; tangential_force its
     tangential part in the nodal frames, a number in 2D and a list of d − 1
     in 3D; beta_mean (weighted by the facet measures) and beta_min are None
@@ -218,16 +242,25 @@ def step_records(solution, history=None):
     and slip are None without friction); contact_measure the width (2D) or
     area (3D) of Γ_C in contact
     (:func:`~adhesive_contact.postprocess.contact_measure`, None without
-    contact nodes);
+    contact nodes), peak_pressure the largest nodal pressure and
+    peak_pressure_at its node's coordinates, stick_measure and
+    slip_measure the measure of the sticking and slipping nodes (None
+    without friction);
     max_penetration is the deepest penetration of a contact node
     (:func:`~adhesive_contact.postprocess.penetration`: into the foundation
     itself with ``[contact.foundation]``, else max_a (u_ν − g)), None without a wall; ``reactions``
     is {side: [F_x, F_y(, F_z)]}, the force each held side's support exerts
     on the body (:mod:`adhesive_contact.postprocess.reactions`), and ``contact_force``
     the total force of Γ_C on the body in global components (None without
-    contact nodes).
+    contact nodes). ``columns``: the run's
+    :func:`~adhesive_contact.postprocess.level_scalars.level_scalars`, when
+    the caller has them.
     """
-    d = solution.u.shape[2]
+    d = solution.problem.dim
+    history = energies(solution) if history is None else history
+    columns = {c.name: c.values for c in (level_scalars(solution, history)
+                                          if columns is None else columns)}
+    measure = "width" if d == 2 else "area"
     normal = solution.total_normal_force()
     tangential = solution.total_tangential_force()
     means = beta_mean(solution)
@@ -239,15 +272,20 @@ def step_records(solution, history=None):
     has_nodes = boundary is not None and boundary.nodes.size > 0
     contact = total_contact_force(solution) if has_nodes else None
     in_contact = contact_measure(solution) if has_nodes else None
-    history = energies(solution) if history is None else history
     debonding = None
     if boundary is not None and boundary.facets.size:
         area, damage = debonded_area(solution)
+        new_area, new_damage = columns[f"debonded_{'length' if d == 2 else 'area'}"], \
+            columns["damage"]
         glue = None if history is None else history.dissipated["debonding"]
-        debonding = (area, damage,
-                     None if glue is None else energy_per_area(glue, area),
-                     None if glue is None else energy_per_area(glue, damage),
+        debonding = (area, damage, new_area, new_damage,
+                     None if glue is None else energy_per_area(glue, new_area),
+                     None if glue is None else energy_per_area(glue, new_damage),
                      debond_fronts(solution) if d == 2 else None)
+    peak = columns.get("peak_pressure")
+    peak_at = (np.stack([columns[f"peak_pressure_{c}"] for c in "xyz"[:d]], axis=1)
+               if peak is not None else None)
+    stick, slip = columns.get(f"stick_{measure}"), columns.get(f"slip_{measure}")
     records = []
     for n, t in enumerate(solution.t):
         has_beta = solution.beta.shape[1] > 0
@@ -264,6 +302,10 @@ def step_records(solution, history=None):
             "stick": _count(states.get("stick"), n),
             "slip": _count(states.get("slip"), n),
             "contact_measure": None if in_contact is None else json_number(in_contact[n]),
+            "peak_pressure": None if peak is None else json_number(peak[n]),
+            "peak_pressure_at": None if peak_at is None else _vector(peak_at[n]),
+            "stick_measure": None if stick is None else json_number(stick[n]),
+            "slip_measure": None if slip is None else json_number(slip[n]),
             "max_penetration": json_number(violation[n]),
             "iterations": int(solution.iterations[n]),
             "residual": json_number(solution.residual[n]),

@@ -1,6 +1,8 @@
-"""ParaView time series of a run: ``solution.xdmf`` (+ ``.h5``) with point
-data u (3 components) and cell data stress (3 × 3 flattened, the plane
-strain σ_zz included) and von_mises; ``contact.xdmf`` (+ ``.h5``) on the
+"""ParaView time series of a run, at its field levels
+(:mod:`.field_levels`), with the fields of ``[output] fields``:
+``solution.xdmf`` (+ ``.h5``) with point data u (3 components) and cell
+data stress (3 × 3 flattened, the plane strain σ_zz included) and
+von_mises; ``contact.xdmf`` (+ ``.h5``) on the
 contact facets (only with contact facets), whose points are the facets'
 vertices alone (:func:`contact_points`, in increasing mesh index), with
 cell data beta and point data u, and at the contact nodes (0 at a clamped
@@ -53,10 +55,20 @@ class _SeriesWriter(meshio.xdmf.TimeSeriesWriter):
             self.h5 = H5File(self.h5_filename, "a")
             self.h5_file = self.h5.file
 
+    def sort_by_time(self):
+        """Order the collection's levels by their time: a level written late
+        (a peak kept until the run's end) takes its place in the series."""
+        grids = list(self.collection)
+        grids.sort(key=lambda grid: float(grid.find("Time").get("Value")))
+        for grid in list(self.collection):
+            self.collection.remove(grid)
+        self.collection.extend(grids)
+
     def __exit__(self, *_):
-        """Write the XDMF file and close the HDF5 file (both, even when the
-        first raises)."""
+        """Write the XDMF file, its levels in order of time, and close the
+        HDF5 file (both, even when the first raises)."""
         try:
+            self.sort_by_time()
             write_xml(self.filename, self.xdmf_file)
         finally:
             if self.h5 is not None:
@@ -93,24 +105,35 @@ def contact_points(problem):
     return np.unique(contact_facets(problem))
 
 
+#: the fields of ``solution.xdmf`` among those of ``output.fields``
+BODY_FIELDS = ("u", "stress", "von_mises")
+
+
 class XdmfSeries:
     """The open time series of one run in ``folder``: :meth:`write` one
     level at a time (anything with ``t``, ``u`` (npoints, d), ``stress``,
     ``stress_zz``, ``beta``, ``contact_force``, ``frame_displacement``,
     ``on_wall`` and ``stuck``, e.g. a :class:`~adhesive_contact.scheme.state.Level`),
-    then :meth:`close`. ``names`` lists the files."""
+    in any order of time, then :meth:`close`. ``fields`` names what is
+    written (``output.fields``: ``u``, ``stress`` and ``von_mises`` in
+    ``solution.xdmf``, which is left out without any of them, and
+    ``contact``, ``contact.xdmf``); ``names`` lists the files."""
 
-    def __init__(self, problem, folder):
+    def __init__(self, problem, folder, fields=("u", "stress", "von_mises", "contact")):
         mesh, d = problem.mesh, problem.dim
-        self.problem = problem
+        self.problem, self.fields = problem, tuple(fields)
         folder = Path(folder)
         fmt = data_format()
         h5 = fmt == "HDF"
-        self.names = ["solution.xdmf"] + ["solution.h5"] * h5
-        self.body = _SeriesWriter(folder / "solution.xdmf", fmt).__enter__()
-        self.body.write_points_cells(mesh.p.T, [(CELL_TYPES[d], mesh.t.T)])
+        self.names = []
+        self.body = None
+        if any(name in self.fields for name in BODY_FIELDS):
+            self.names += ["solution.xdmf"] + ["solution.h5"] * h5
+            self.body = _SeriesWriter(folder / "solution.xdmf", fmt).__enter__()
+            self.body.write_points_cells(mesh.p.T, [(CELL_TYPES[d], mesh.t.T)])
         self.contact = None
-        if problem.boundary is not None and problem.boundary.facets.size:
+        if ("contact" in self.fields and problem.boundary is not None
+                and problem.boundary.facets.size):
             self.names += ["contact.xdmf"] + ["contact.h5"] * h5
             self.points = contact_points(problem)
             self.contact_nodes = np.searchsorted(self.points, problem.boundary.nodes)
@@ -120,11 +143,18 @@ class XdmfSeries:
                 [(FACET_TYPES[d], np.searchsorted(self.points, contact_facets(problem)))])
 
     def write(self, level):
-        stress = stress_3x3(level)
         u = pad_vectors(level.u)
-        self.body.write_data(float(level.t), point_data={"u": u},
-                             cell_data={"stress": [stress.reshape(-1, 9)],
-                                        "von_mises": [von_mises(stress)]})
+        if self.body is not None:
+            point_data, cell_data = {}, {}
+            if "u" in self.fields:
+                point_data["u"] = u
+            if "stress" in self.fields or "von_mises" in self.fields:
+                stress = stress_3x3(level)
+                if "stress" in self.fields:
+                    cell_data["stress"] = [stress.reshape(-1, 9)]
+                if "von_mises" in self.fields:
+                    cell_data["von_mises"] = [von_mises(stress)]
+            self.body.write_data(float(level.t), point_data=point_data, cell_data=cell_data)
         if self.contact is not None:
             self.contact.write_data(float(level.t),
                                     point_data={"u": u[self.points], **self._nodal(level)},
@@ -175,13 +205,16 @@ class _LevelOf:
         self.stress_zz = None if solution.stress_zz is None else solution.stress_zz[n]
 
 
-def write_xdmf(solution, folder):
-    """Write the ParaView time series of a finished solution into ``folder``;
-    return the names of the files written."""
-    series = XdmfSeries(solution.problem, folder)
+def write_xdmf(solution, folder, levels=None):
+    """Write the ParaView time series of a finished solution into ``folder``:
+    the fields of its problem's ``output.fields`` at ``levels`` (default:
+    every level); return the names of the files written."""
+    output = solution.problem.output
+    fields = output.fields if output is not None else BODY_FIELDS + ("contact",)
+    series = XdmfSeries(solution.problem, folder, fields)
     try:
-        for n in range(solution.t.size):
-            series.write(_LevelOf(solution, n))
+        for n in (range(solution.t.size) if levels is None else levels):
+            series.write(_LevelOf(solution, int(n)))
     finally:
         series.close()
     return series.names

@@ -6,7 +6,8 @@ scalars a study reports (:mod:`.scalars`).
 Their figures are :mod:`adhesive_contact.visuals`."""
 
 from .energy import DISSIPATED, STORED, EnergyHistory, energies, energy_unavailable
-from .fracture import debond_front, debond_fronts, debonded_area, energy_per_area
+from .fracture import (debond_front, debond_fronts, debonded_area, energy_per_area,
+                       new_debonding)
 from .quantities import (FRAMES, beta_mean, cell_von_mises, contact_fields,
                          contact_nodal_forces, contact_traction, normal_traction, penetration,
                          stress_3x3, tangential_traction, to_global, total_contact_force,
@@ -19,7 +20,8 @@ from .states import (COMPLIANCE, SEPARATED, SLIP, STATE_NAMES, STATE_TOLERANCE, 
                      contact_state_counts, contact_states, state_masks, state_tolerance)
 
 __all__ = ["DISSIPATED", "STORED", "EnergyHistory", "energies", "energy_unavailable",
-           "debond_front", "debond_fronts", "debonded_area", "energy_per_area", "FRAMES",
+           "debond_front", "debond_fronts", "debonded_area", "energy_per_area", "new_debonding",
+           "FRAMES",
            "beta_mean", "cell_von_mises", "contact_fields", "contact_nodal_forces",
            "contact_traction", "normal_traction", "penetration", "stress_3x3",
            "tangential_traction", "to_global", "total_contact_force", "von_mises",

@@ -298,7 +298,8 @@ def energies(solution):
 
     Parameters
     ----------
-    solution : Solution (u read one level at a time, so a streamed one works)
+    solution : Solution (u read one level at a time, so a streamed one works;
+        one read back from a folder gives the energies it recorded)
 
     Returns
     -------
@@ -307,6 +308,14 @@ def energies(solution):
     problem = solution.problem
     if energy_unavailable(problem) is not None:
         return None
+    recorded = getattr(solution, "scalars", None)
+    if recorded is not None and "external_work" in recorded:   # read back from a folder
+        return EnergyHistory(
+            t=np.asarray(solution.t, dtype=float).copy(),
+            external_work=np.asarray(recorded["external_work"][1]),
+            stored={part: np.asarray(recorded[f"stored_{part}"][1]) for part in STORED},
+            dissipated={part: np.asarray(recorded[f"dissipated_{part}"][1])
+                        for part in DISSIPATED})
     with one_blas_thread():   # level-sized products: threads only wait on each other
         elastic, memory, viscous, numerical = bulk_energies(problem, solution.u)
         layer, glue, friction, debonding, bregman, wall = contact_energies(solution)

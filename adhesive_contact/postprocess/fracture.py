@@ -6,8 +6,11 @@ in 2D, per unit thickness; an area in 3D):
 - the debonded area A_½ = Σ_f |f| [β_f < ½], and the damage integral
   A_D = ∫_{Γ_C} (1 − β) = Σ_f |f| (1 − β_f) (β_0 = 1: the area that would
   have debonded if the damage were gathered in one place);
-- the glue's dissipated energy per unit debonded area, D^b_n / A_½ and
-  D^b_n / A_D, D^b the debonding dissipation of :mod:`.energy`;
+- those of the run alone, a pre-crack (β_0 < ½) left out:
+  A_½^new = Σ_f |f| [β_f < ½ ≤ β_{0,f}] and ∫_{Γ_C} (β_0 − β);
+- the glue's dissipated energy per unit area the run debonded,
+  D^b_n / A_½^new and D^b_n / ∫ (β_0 − β), D^b the debonding dissipation
+  of :mod:`.energy`;
 - the debond front: where β crosses ½ between two adjacent facets (sharing
   a vertex in 2D, an edge in 3D), placed by linear interpolation of β
   between their midpoints.
@@ -27,6 +30,20 @@ def debonded_area(solution, threshold=0.5):
         return zeros, zeros.copy()
     beta = np.asarray(solution.beta)
     return (beta < threshold) @ boundary.measure, (1.0 - beta) @ boundary.measure
+
+
+def new_debonding(solution):
+    """(debonded, damage) per level (M+1,): the measure of the facets that
+    debonded during the run (β_f < ½, β_{0,f} ≥ ½) and ∫_{Γ_C} (β₀ − β).
+    Zeros without contact facets."""
+    boundary = solution.problem.boundary
+    if boundary is None or boundary.facets.size == 0:
+        zeros = np.zeros(solution.t.size)
+        return zeros, zeros.copy()
+    beta = np.asarray(solution.beta)
+    beta0 = np.asarray(solution.problem.beta0)
+    debonded = ((beta < 0.5) & (beta0 >= 0.5)) @ boundary.measure
+    return debonded, (beta0 - beta) @ boundary.measure
 
 
 def adjacent_facets(problem):

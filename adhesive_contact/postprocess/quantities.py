@@ -200,8 +200,8 @@ def penetration(solution):
     if foundation is None or problem.gap is None or problem.gap.shape[1] == 0:
         return solution.gap_violation()
     boundary = problem.boundary
-    x = problem.mesh.p[:, boundary.nodes]                               # (d, nc)
-    # level by level: u may be read from disk (StreamingRecorder)
-    depth = np.array([-signed_distance(foundation, x + solution.u[n][boundary.nodes].T)
-                      for n in range(solution.t.size)]).reshape(solution.t.size, -1)
-    return np.where(boundary.held[:, 0], -np.inf, depth).max(axis=1)
+    levels, nc, d = solution.frame_displacement.shape
+    # u_a = R_a z_a at the contact nodes: every level's, without the fields
+    x = problem.mesh.p[:, boundary.nodes].T + to_global(problem, solution.frame_displacement)
+    depth = -signed_distance(foundation, x.reshape(-1, d).T).reshape(levels, nc)
+    return np.where(boundary.held[:, 0], -np.inf, depth).max(axis=1, initial=-np.inf)

@@ -1,9 +1,11 @@
 """Reaction forces of the supports, per held side.
 
-The scheme records, per level, the nodal reaction r_D = (a_n u_n)_D − f_D
-at each held dof (:mod:`adhesive_contact.fem.dirichlet`): the force the
-support exerts on the body, with f the load minus the memory history's
-force. The held dofs are never rotated, so r_D is in global components.
+The scheme records, per level, the nodal reaction
+r_D = (a_n u_n)_D − f_D − F_D at each held dof
+(:mod:`adhesive_contact.fem.dirichlet`): the force the support alone
+exerts on the body, with f the load minus the memory history's force and
+F_D the contact laws' force at a held vertex of Γ_C (in the contact force,
+docs/conventions.md). The held dofs are never rotated, so r_D is in global components.
 A side's reaction is the sum of the nodal reactions of its held
 components; a dof held by several sides (a corner) is shared equally
 between them, so the sides add up to the total support force. Components
@@ -48,13 +50,35 @@ def prescribed_history(solution, side):
     return out
 
 
-def side_mean_displacement(solution, side):
-    """The mean nodal displacement of a side per level (M+1, d)."""
+def side_displacements(solution, sides):
+    """{side: (M+1, d)} the mean nodal displacement of each of ``sides``
+    at every level, reading u one level at a time (it may be on disk); a
+    solution read back from a folder whose fields are kept at some levels
+    only gives its recorded columns ``displacement_<side>_<c>``
+    (:mod:`.level_scalars`), NaN for a component it did not record."""
     from ..fem.meshes import named_facets
 
-    mesh = solution.problem.mesh
-    nodes = np.unique(mesh.facets[:, named_facets(mesh, [side], "side", indexed=False)])
-    return np.array([solution.u[n][nodes].mean(axis=0) for n in range(solution.t.size)])
+    problem = solution.problem
+    recorded = getattr(solution, "scalars", None)
+    if recorded is not None:
+        return {side: np.stack([recorded.get(f"displacement_{side}_{'xyz'[c]}",
+                                             (None, np.full(solution.t.size, np.nan)))[1]
+                                for c in range(problem.dim)], axis=1) for side in sides}
+    mesh = problem.mesh
+    nodes = {side: np.unique(mesh.facets[:, named_facets(mesh, [side], "side", indexed=False)])
+             for side in sides}
+    out = {side: np.zeros((solution.t.size, problem.dim)) for side in sides}
+    for n in range(solution.t.size):
+        u = np.asarray(solution.u[n])
+        for side in sides:
+            out[side][n] = u[nodes[side]].mean(axis=0)
+    return out
+
+
+def side_mean_displacement(solution, side):
+    """The mean nodal displacement of a side per level (M+1, d)
+    (:func:`side_displacements`)."""
+    return side_displacements(solution, [side])[side]
 
 
 def applied_traction(problem, side, times):

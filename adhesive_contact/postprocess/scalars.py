@@ -15,13 +15,14 @@ over the levels, with its sign) and ``reaction_<side>_<x|y|z>_T``;
 ``work_T``, ``stored_T``, ``dissipated_T``, ``viscous_T``,
 ``debonding_T``, ``numerical_T``, ``balance_T`` (None without an energy
 balance, :mod:`.energy`); ``debonded_area_T``, ``damage_T`` and
-``glue_energy_per_area_T`` (None without contact facets, :mod:`.fracture`).
+``glue_energy_per_area_T`` (per area the run debonded, a pre-crack left
+out; None without contact facets, :mod:`.fracture`).
 """
 
 import numpy as np
 
 from .energy import energies, energy_unavailable
-from .fracture import debonded_area, energy_per_area
+from .fracture import debonded_area, energy_per_area, new_debonding
 from .quantities import beta_mean
 from .reactions import reaction_sides, reactions
 from .states import contact_state_counts
@@ -89,8 +90,9 @@ def scalar_quantities(solution):
         out.update(dict.fromkeys(DEBONDING_NAMES))
         return out
     area, damage = debonded_area(solution)
+    new_area = new_debonding(solution)[0]
     per = (None if history is None else
-           energy_per_area(history.dissipated["debonding"][-1:], area[-1:])[0])
+           energy_per_area(history.dissipated["debonding"][-1:], new_area[-1:])[0])
     out.update(debonded_area_T=float(area[-1]), damage_T=float(damage[-1]),
                glue_energy_per_area_T=None if per is None or np.isnan(per) else float(per))
     return out
@@ -101,6 +103,22 @@ def quantity_names(problem):
     :func:`state_quantities` and :func:`scalar_quantities`, in order (a
     value may still be None: no energy balance, no facets, no wall)."""
     return [*STATE_NAMES, *reaction_names(problem), *ENERGY_NAMES, *DEBONDING_NAMES]
+
+
+#: the kind (:mod:`.units`) of each quantity that is no reaction
+KINDS = {"beta_min_T": "1", "beta_mean_T": "1", "max_un_minus_g": "length",
+         "separated_T": "count", "on_wall_T": "count", "compliance_T": "count",
+         "stick_T": "count", "slip_T": "count", "normal_force_T": "force",
+         **dict.fromkeys(ENERGY_NAMES, "energy"), "debonded_area_T": "measure",
+         "damage_T": "measure", "glue_energy_per_area_T": "toughness"}
+
+
+def quantity_kind(name):
+    """The kind of quantity ``name`` of :func:`quantity_names` (a force, an
+    energy, ...: :mod:`.units`); None for a name that is none of them."""
+    if name.startswith("reaction_") and name.endswith(("_peak", "_T")):
+        return "force"
+    return KINDS.get(name)
 
 
 def quantity_unavailable(problem, name):

@@ -38,7 +38,7 @@ from ..fem.contact_boundary import (
     tangent_frame,
 )
 from ..fem.dirichlet import prescribed_displacement, rigid_modes
-from ..scheme.options import SchemeOptions, SolverOptions
+from ..scheme.options import OutputOptions, SchemeOptions, SolverOptions
 from ..fem.foundation import foundation_gap, foundation_normal, signed_distance
 from ..fem.meshes import build_mesh, named_facets
 from ..laws import make_bonding, make_friction, make_normal_law
@@ -87,7 +87,9 @@ def build_problem(scene):
                    bonding=laws.bonding, probe_map=probe_map, times=times,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
                    beta_source=beta_source, held_by_contact=held_by_contact,
-                   options=scheme_options(scene))
+                   options=scheme_options(scene),
+                   output=OutputOptions(every=scene.every, fields=scene.fields,
+                                        units=dict(scene.units)))
 
 
 def scheme_options(scene):

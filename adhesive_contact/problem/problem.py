@@ -42,6 +42,7 @@ class Problem:
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
     held_by_contact: tuple = ()  # the rigid motions only the contact terms hold, in words
     options: object = None    # SchemeOptions: what the scheme reads of the scene
+    output: object = None     # OutputOptions: what a run writes ([output])
     _smallness: dict = field(default=None, repr=False)
     _geometry: tuple = field(default=None, repr=False)
 

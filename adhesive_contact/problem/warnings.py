@@ -110,10 +110,11 @@ def geometry_warning(solution):
     _, volume = problem.geometry
     total = volume.sum()
     worst = None
-    count = solution.t.size
-    levels = np.unique(np.round(np.linspace(0, count - 1, min(count, GEOMETRY_LEVELS))))
-    for n in levels.astype(int):   # one level at a time (a streamed u is on disk)
-        strain, rotation, quadratic = gradient_measures(problem, np.asarray(solution.u[n]))
+    held = solution.levels_with_fields()
+    count = held.size
+    picks = np.unique(np.round(np.linspace(0, count - 1, min(count, GEOMETRY_LEVELS))))
+    for n in held[picks.astype(int)]:   # one level at a time (a streamed u is on disk)
+        strain, rotation, quadratic = gradient_measures(problem, solution.displacement(n))
         beyond = (strain > STRAIN_LIMIT) | (quadratic > GREEN_LAGRANGE_GAP)
         share = volume[beyond].sum() / total
         if share > VOLUME_SHARE and (worst is None or share > worst[0]):

@@ -129,6 +129,11 @@ MIN_MODULUS = 1e-100        # μ of an elastic tensor, and the bulk modulus λ +
 MIN_STEP = 1e-100           # k = T/N: the time levels n k keep their precision
 MAX_HALVINGS = 20           # k_min ≥ k_max 2^-20 (time.adaptive.k_min)
 
+#: the fields a run may write at its field levels (``output.fields``):
+#: u (solution.xdmf and solution.npz), the cell stress and its von Mises
+#: value (solution.xdmf), the contact fields (contact.xdmf)
+OUTPUT_FIELDS = ("u", "stress", "von_mises", "contact")
+
 _DECLARATIONS = (
     Key("title", "str", "untitled", "the scene's title (it heads every plot)"),
     Key("dim", "int", REQUIRED, "the space dimension: 2 (plane strain) or 3", choices=(2, 3)),
@@ -141,7 +146,7 @@ _DECLARATIONS = (
     Key("contact", "table", None, "the contact terms on Γ_C (none when absent)"),
     Key("time", "table", REQUIRED, "the time grid"),
     Key("solver", "table", None, "the step method and the linear backend"),
-    Key("output", "table", None, "the probes and the units of the plots"),
+    Key("output", "table", None, "the probes, the levels and fields written, the units"),
     Key("exact", "table", None, "a manufactured solution (none when absent)"),
 
     Key("mesh.domain", "str", REQUIRED, "the domain: a rectangle, a box or a mesh file",
@@ -260,6 +265,10 @@ _DECLARATIONS = (
     Key("output.probes", "list", (), "the points whose displacement is recorded"),
     Key("output.plot_times", "list", "auto", "the times the figures draw: a list of times "
         "in [0, T], or \"auto\" (where the run's activity is, and T)"),
+    Key("output.every", "int", 1, "fields are written at every N-th level (and at the "
+        "first, the last and the peaks of the reported forces)", bounds=Interval(1, 10**9)),
+    Key("output.fields", "list", OUTPUT_FIELDS, "the fields written at those levels, out of "
+        "u, stress, von_mises, contact (an empty list: the scalars only)"),
     Key("output.units", "table", None, "the names of the units the scene's numbers are in "
         "(none when absent)"),
     Key("output.units.length", "str", None, "the unit of length, on the plots' axes"),

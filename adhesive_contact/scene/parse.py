@@ -57,14 +57,14 @@ def scene_from_dict(data, base_dir=None):
     T, steps, scheme, adaptive = read_time(top.table("time"))
     contact = scheme_integrator(contact, scheme, data)
     solver = read_solver(top.table("solver"))
-    probes, units, plot_times = read_output(top.table("output"), dim, T)
+    probes, units, plot_times, every, fields = read_output(top.table("output"), dim, T)
     exact = read_exact(top.table("exact"), dim, contact, top.has("loads"))
     top.finish()
     if memory is not None and memory.kernel == "relaxation":
         check_relaxation_step(memory, dim, T / steps)   # k_max: the largest step
     scene = Scene(title, dim, mesh, dirichlet, contact_sides, material, memory, body,
                   traction, contact, T, steps, solver, probes, exact, displacement, units,
-                  plot_times, scheme, adaptive)
+                  plot_times, scheme, adaptive, every, fields)
     check_something_holds(scene, by_file)
     return scene
 

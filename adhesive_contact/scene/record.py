@@ -36,7 +36,12 @@ def resolved(scene):
         "output": {"probes": [list(p) for p in scene.probes],
                    **({"units": dict(scene.units)} if scene.units else {}),
                    **({"plot_times": list(scene.plot_times)}
-                      if scene.plot_times != "auto" else {})},
+                      if scene.plot_times != "auto" else {}),
+                   # only when not the defaults: a study recorded before the keys resumes
+                   **({"every": scene.every} if scene.every != default("output.every")
+                      else {}),
+                   **({"fields": list(scene.fields)}
+                      if scene.fields != default("output.fields") else {})},
         "exact": _exact_record(scene.exact),
     }
 

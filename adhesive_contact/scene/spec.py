@@ -224,6 +224,8 @@ class Scene:
     plot_times: object = "auto"   # the figures' times: "auto" or a sorted tuple
     scheme: str = default("time.scheme")   # "paper" or "second-order" (docs/scheme.md)
     adaptive: AdaptiveSpec = None   # [time.adaptive], or None: uniform steps k = T/N
+    every: int = default("output.every")     # fields at every N-th level (and more)
+    fields: tuple = default("output.fields")  # the fields written there
 
     @property
     def held_sides(self):

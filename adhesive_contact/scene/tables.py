@@ -13,7 +13,8 @@ from ..fem.meshes.builtin import SIDES, nodes_of
 from ..linear_solvers.pardiso import available as pardiso_available
 from ..verification.manufactured import symbolic_problem
 from .errors import SceneError
-from .keys import MAX_CELL_ASPECT, MAX_HALVINGS, MAX_NODES, MAX_UNIT, MIN_STEP, declared, keys_in
+from .keys import (MAX_CELL_ASPECT, MAX_HALVINGS, MAX_NODES, MAX_UNIT, MIN_STEP, OUTPUT_FIELDS,
+                   declared, default, keys_in)
 from .reader import coordinates, expression, show, vector_of_expressions
 from .spec import AdaptiveSpec, ExactSpec, MeshSpec, SolverSpec
 
@@ -294,13 +295,32 @@ MAX_PLOT_TIMES = 12
 
 
 def read_output(table, dim, T):
-    """(probes, units, plot times) of the [output] table: none of the first
-    two and "auto" without it."""
+    """(probes, units, plot times, every, fields) of the [output] table:
+    none of the first two, "auto", 1 and every field without it."""
     if table is None:
-        return (), {}, "auto"
+        return (), {}, "auto", default("output.every"), default("output.fields")
     units = _read_units(table.table("units"))
     times = _read_plot_times(table, T)
-    return _read_probes(table, dim), units, times
+    every = table.read("every")
+    fields = _read_fields(table)
+    return _read_probes(table, dim), units, times, every, fields
+
+
+def _read_fields(table):
+    """``output.fields``: a list of distinct names of OUTPUT_FIELDS (in that order)."""
+    raw = table.read("fields")
+    key = table.key("fields")
+    allowed = OUTPUT_FIELDS
+    if not all(isinstance(name, str) for name in raw):
+        raise SceneError(key, f"must be a list of field names out of "
+                         f"{', '.join(allowed)}, got {show(raw)}")
+    for name in raw:
+        if name not in allowed:
+            raise SceneError(key, f"{show(name)} is no field; allowed: "
+                             f"{', '.join(allowed)} (an empty list writes the scalars only)")
+    if len(set(raw)) != len(raw):
+        raise SceneError(key, f"names a field twice: {show(raw)}")
+    return tuple(name for name in allowed if name in raw)
 
 
 def _read_plot_times(table, T):

@@ -1,4 +1,5 @@
-"""What a run of the scheme is told, resolved once from its scene.
+"""What a run of the scheme is told, and what it keeps, resolved once from
+its scene.
 
 :func:`~adhesive_contact.problem.build.build_problem` fills a
 :class:`SchemeOptions` (``problem.options``) from the validated scene; the
@@ -64,3 +65,24 @@ class SchemeOptions:
     def second_order(self):
         """Whether the trapezoidal memory and the midpoint bonding step run."""
         return self.scheme == "second-order"
+
+
+@dataclass(frozen=True)
+class OutputOptions:
+    """What a run writes (the scene's ``[output]``).
+
+    ``every`` N: the field levels are every N-th level, the first, the
+    last and each level where a reported force peaks
+    (:class:`adhesive_contact.io.StreamingRecorder`); ``fields`` the
+    fields written there, out of ``u``, ``stress``, ``von_mises`` and
+    ``contact`` (none: the scalars only, which every level keeps);
+    ``units`` {quantity: unit name} of ``[output.units]``, for the
+    column names of scalars.csv and the plots' axes."""
+
+    every: int = 1
+    fields: tuple = ("u", "stress", "von_mises", "contact")
+    units: dict = None
+
+    def writes(self, name):
+        """Whether field ``name`` is written at the field levels."""
+        return name in self.fields

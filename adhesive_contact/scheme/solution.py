@@ -74,6 +74,13 @@ class Solution:
     # [time.adaptive]: the controller's figures (tol, accepted and rejected
     # pairs, step solves, step sizes used, ...), else None
     adaptive: dict = None
+    # the levels whose u (and σ) ``u`` holds, increasing, when not every
+    # level's: a folder written with [output] every > 1 read back
+    # (adhesive_contact.io.load_solution); None: u[n] is level n
+    field_levels: np.ndarray = None
+    # the scalars of every level recorded with those fields ({name: (kind,
+    # values)}, adhesive_contact.postprocess.level_scalars), or None
+    scalars: dict = None
 
     @property
     def success(self):
@@ -84,6 +91,30 @@ class Solution:
     def steps(self):
         """The number of steps computed, M (levels 1..M)."""
         return self.t.size - 1
+
+    def levels_with_fields(self):
+        """The levels whose u this solution holds (every level by default)."""
+        if self.field_levels is None:
+            return np.arange(self.t.size)
+        return np.asarray(self.field_levels)
+
+    def nearest_field_level(self, n):
+        """The level with fields nearest to level ``n`` (``n`` itself when held)."""
+        levels = self.levels_with_fields()
+        return int(levels[np.argmin(np.abs(levels - int(n) % self.t.size))])
+
+    def displacement(self, n):
+        """u at level ``n`` (npoints, d); ValueError for a level without
+        fields (:meth:`levels_with_fields`)."""
+        if self.field_levels is None:
+            return np.asarray(self.u[n])
+        n = int(n) % self.t.size
+        position = np.searchsorted(self.field_levels, n)
+        if position == len(self.field_levels) or self.field_levels[position] != n:
+            raise ValueError(f"level {n} has no fields here: the run wrote them at "
+                             f"{len(self.field_levels)} of {self.t.size} levels "
+                             "([output] every, fields); its scalars are in scalars.csv")
+        return np.asarray(self.u[position])
 
     @property
     def normal_displacement(self):

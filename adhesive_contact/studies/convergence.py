@@ -41,7 +41,9 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..postprocess.scalars import quantity_names, quantity_unavailable, study_quantities
+from ..postprocess.scalars import (quantity_kind, quantity_names, quantity_unavailable,
+                                   study_quantities)
+from ..postprocess.units import unit_of
 from ..problem.build import build_problem
 from ..verification.rates import pairwise_rates, rates
 from ..verification.levels import (
@@ -49,6 +51,7 @@ from ..verification.levels import (
     Reference,
     default_reference_refinement,
     level_scene,
+    needed_levels,
     reference_scene,
     run_level,
     run_reference,
@@ -84,22 +87,28 @@ MAX_DOFS = 2_000_000
 
 
 def save_reference(path, reference):
-    """``reference.npz``: the arrays of a :class:`Reference`, its refine, steps, seconds."""
+    """``reference.npz``: the arrays of a :class:`Reference` (u and β at
+    the levels its errors read, ``kept``; stored uncompressed: zlib shrinks
+    floating-point fields by a few per cent, slowly), its refine, steps,
+    seconds and quantities."""
     arrays = {"t": reference.t, "u": reference.u, "beta": reference.beta,
               "facets": np.asarray(reference.facets, dtype=np.int64),
               "refine": np.int64(reference.scene.mesh.refine),
               "steps": np.int64(reference.scene.steps),
               "seconds": np.float64(reference.seconds)}
+    if reference.kept is not None:
+        arrays["kept"] = np.asarray(reference.kept, dtype=np.int64)
     if reference.quantities is not None:
         arrays["quantities"] = np.array(json.dumps(reference.quantities))
-    write_atomic(path, lambda f: np.savez_compressed(f, **arrays), binary=True)
+    write_atomic(path, lambda f: np.savez(f, **arrays), binary=True)
 
 
-def load_reference(path, scene, arrays=True, quantity=None):
+def load_reference(path, scene, arrays=True, quantity=None, kept=None):
     """The saved :class:`Reference` of reference scene ``scene``; None when
     ``path`` is missing, unreadable or of another refine or number of steps,
-    or, with a ``quantity`` name, when it has no value of that quantity (a
-    reference saved before its quantities were kept).
+    with a ``quantity`` name, when it has no value of that quantity (a
+    reference saved before its quantities were kept), or when it lacks a
+    level of ``kept`` (the levels the study's errors read; None: every one).
 
     With ``arrays=False`` only its seconds are read (t, u, beta, facets None):
     a study whose levels are all saved needs no more."""
@@ -117,10 +126,14 @@ def load_reference(path, scene, arrays=True, quantity=None):
                 return None
             if not arrays:
                 return Reference(scene, None, None, None, None, seconds, quantities)
-            if data["t"].shape != (scene.steps + 1,) or data["u"].shape[0] != scene.steps + 1:
+            held = (data["kept"] if "kept" in data.files
+                    else np.arange(scene.steps + 1))
+            wanted = np.arange(scene.steps + 1) if kept is None else np.asarray(kept)
+            if (data["t"].shape != (scene.steps + 1,) or data["u"].shape[0] != held.size
+                    or not np.isin(wanted, held).all()):
                 return None
             return Reference(scene, data["t"], data["u"], data["beta"], data["facets"],
-                             seconds, quantities)
+                             seconds, quantities, None if "kept" not in data.files else held)
     except (OSError, KeyError, ValueError, TypeError, zipfile.BadZipFile):
         return None
 
@@ -235,12 +248,23 @@ def csv_columns(document):
     return CSV_COLUMNS + (QUANTITY_COLUMNS if "quantity" in document else ())
 
 
+def csv_header(document):
+    """:func:`csv_columns` with their units where the scene names them
+    (``document["units"]``: h, k, and the quantity and its error)."""
+    units = document.get("units") or {}
+    unit = {"h": units.get("length"), "k": units.get("time")}
+    if "quantity" in document:
+        unit["quantity"] = unit["err_q"] = document["quantity"].get("unit")
+    return [f"{c} [{unit[c]}]" if unit.get(c) else c for c in csv_columns(document)]
+
+
 def write_errors_csv(path, document):
     """``errors.csv``: a header of :func:`csv_columns`, then one row per
     level (:func:`adhesive_contact.storage.write_csv`: None — a rate_E on
     the first level, a relative error of a zero solution or of a level
     saved without it — an empty cell)."""
-    write_csv(path, csv_columns(document), document["levels"])
+    rows = [[level.get(c) for c in csv_columns(document)] for level in document["levels"]]
+    write_csv(path, csv_header(document), rows)
 
 
 # ---------------------------------------------------------------- in a worker
@@ -467,7 +491,8 @@ class ConvergenceStudy(Study):
         """(reference, loaded): from ``reference.npz``, else run and saved."""
         rscene = self.reference_scene
         fine = load_reference(self.folder / REFERENCE, rscene, arrays=arrays,
-                              quantity=self.quantity)
+                              quantity=self.quantity,
+                              kept=needed_levels(self.scene, self.param, self.levels, rscene))
         if fine is not None:
             return fine, True
         total = rscene.steps + 1
@@ -539,6 +564,11 @@ class ConvergenceStudy(Study):
         if self.reference == "fine":
             info["h"] = records[-1]["h"] / 2 ** self.ref_h
         document = results(records, self.param, info, self.quantity)
+        document["units"] = dict(self.scene.units)
+        if self.quantity is not None:
+            kind = quantity_kind(self.quantity)
+            document["quantity"]["unit"] = (None if kind is None else
+                                            unit_of(kind, self.scene.units, self.scene.dim))
         document["warnings"] = trust(document)
         document["trustworthy"] = not document["warnings"]
         files = ["errors.csv", "rates.json"]

@@ -39,7 +39,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import SceneError, build_problem, scene_from_dict, solve
-from ..postprocess.scalars import scalar_quantities, state_quantities
+from ..postprocess.scalars import quantity_kind, scalar_quantities, state_quantities
+from ..postprocess.units import with_unit
 from ..problem.warnings import solution_warnings
 from ..storage import plain, toml_value, write_csv
 from .study import Study, StudyError, scene_identity, scene_source
@@ -265,10 +266,16 @@ def run_row(record, keys, quantities=()):
     return row
 
 
-def write_runs_csv(path, rows, keys, quantities=()):
-    """``runs.csv``: a header of :func:`csv_columns`, one row per run
+def write_runs_csv(path, rows, keys, quantities=(), units=None, dim=2):
+    """``runs.csv``: a header of :func:`csv_columns`, the measured
+    quantities with their units where the base scene names them
+    (``units``: ``[output.units]``, ``dim`` its dimension), one row per run
     (:func:`adhesive_contact.storage.write_csv`; None an empty cell)."""
-    write_csv(path, csv_columns(keys, quantities), rows)
+    columns = csv_columns(keys, quantities)
+    measured = set(MEASURED) | set(quantities)
+    header = [with_unit(c, quantity_kind(c), units, dim) if c in measured and quantity_kind(c)
+              else c for c in columns]
+    write_csv(path, header, [[row.get(c) for c in columns] for row in rows])
 
 
 # ---------------------------------------------------------------- the study
@@ -448,7 +455,8 @@ class Sweep(Study):
         records = [done[key] if key in done else lost[key] for key in self.keys()]
         quantities = quantity_columns(records)
         rows = [run_row(record, self.keys_set, quantities) for record in records]
-        write_runs_csv(self.folder / "runs.csv", rows, self.keys_set, quantities)
+        write_runs_csv(self.folder / "runs.csv", rows, self.keys_set, quantities,
+                       self.base.units, self.base.dim)
         return SweepResult(records, rows, [key for key in computed if key not in lost],
                            ["runs.csv"], sorted(lost))
 

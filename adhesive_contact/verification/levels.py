@@ -82,28 +82,70 @@ def reference_scene(scene, param, levels, ref_h=None, ref_k=None):
 
 @dataclass
 class Reference:
-    """A fine discrete solution: its scene and its history."""
+    """A fine discrete solution: its scene and the history its errors need.
+
+    ``u`` and ``beta`` hold the reference levels ``kept`` (increasing; None:
+    every level n = 0..N): :meth:`level_u` and :meth:`level_beta` read a
+    level by its index n."""
 
     scene: object
-    t: np.ndarray        # (N+1,)
-    u: np.ndarray        # (N+1, npoints, d)
-    beta: np.ndarray     # (N+1, nf)
+    t: np.ndarray        # (N+1,) every level's time
+    u: np.ndarray        # (len(kept), npoints, d)
+    beta: np.ndarray     # (len(kept), nf)
     facets: np.ndarray   # contact facets of the fine mesh, in Γ_C order
     seconds: float
     quantities: dict = None   # its scalar quantities (postprocess.scalars), None if not kept
+    kept: np.ndarray = None   # the levels u and beta hold, None: every level
+
+    def _position(self, n):
+        if self.kept is None:
+            return n
+        position = int(np.searchsorted(self.kept, n))
+        if position == len(self.kept) or self.kept[position] != n:
+            raise ValueError(f"the reference keeps no level {n}")
+        return position
+
+    def level_u(self, n):
+        """u of reference level n."""
+        return self.u[self._position(n)]
+
+    def level_beta(self, n):
+        """β of reference level n."""
+        return self.beta[self._position(n)]
+
+
+def needed_levels(scene, param, levels, reference):
+    """The reference levels the errors of a study's levels read (None:
+    every one). A uniform level of N_l steps reads the reference at its
+    t_n = n T/N_l, the levels n·(N_ref/N_l); the finest level's steps divide
+    every other's, so those of the finest are all (a k-study with the
+    default 16 times the finest steps keeps one level in 16). An adaptive
+    level's times are known only once it runs: every level is kept."""
+    finest = level_scene(scene, param, levels - 1)
+    if finest.adaptive is not None or reference.adaptive is not None:
+        return None
+    ratio = reference.steps // finest.steps
+    if ratio * finest.steps != reference.steps or ratio == 1:
+        return None
+    return np.arange(0, reference.steps + 1, ratio)
 
 
 def run_reference(scene, param, levels, ref_h=None, ref_k=None, progress=None, measure=None):
     """Solve the reference run of a study (``progress(n, N)`` per step);
-    ``measure(solution)``, optional, gives its ``quantities`` (a dict)."""
+    ``measure(solution)``, optional, gives its ``quantities`` (a dict). The
+    Reference keeps the levels its errors read (:func:`needed_levels`)."""
     ref = reference_scene(scene, param, levels, ref_h, ref_k)
     t0 = time.perf_counter()
     problem = build_problem(ref)
     solution = solve(problem, progress, raise_on_failure=True)
     facets = problem.boundary.facets if problem.boundary is not None else np.zeros(0, int)
+    quantities = None if measure is None else measure(solution)
     seconds = time.perf_counter() - t0
-    return Reference(ref, solution.t, solution.u, solution.beta, facets, seconds,
-                     None if measure is None else measure(solution))
+    kept = needed_levels(scene, param, levels, ref)
+    u, beta = solution.u, solution.beta
+    if kept is not None:
+        u, beta = np.ascontiguousarray(u[kept]), np.ascontiguousarray(beta[kept])
+    return Reference(ref, solution.t, u, beta, facets, seconds, quantities, kept)
 
 
 def _errors_against_reference(problem, solution, reference):
@@ -127,7 +169,7 @@ def _errors_against_reference(problem, solution, reference):
     lengths = _facet_lengths(fine, reference.facets)
     err_u, err_b, norm_u, norm_b = [], [], [], []
     for n, weights in enumerate(at):
-        ref_u = _combine(reference.u, weights)
+        ref_u = _combine(reference.level_u, weights)
         uf = P @ solution.u[n]                                   # (npoints_f, d)
         du = (uf - ref_u).ravel()
         err_u.append(strain_error_fine(fine, B, du))
@@ -136,7 +178,7 @@ def _errors_against_reference(problem, solution, reference):
             err_b.append(0.0)
             norm_b.append(0.0)
         else:
-            ref_beta = _combine(reference.beta, weights)
+            ref_beta = _combine(reference.level_beta, weights)
             db = solution.beta[n][parents] - ref_beta
             err_b.append(float(np.sqrt(np.sum(lengths * db * db))))
             norm_b.append(float(np.sqrt(np.sum(lengths * ref_beta * ref_beta))))
@@ -156,12 +198,12 @@ def reference_at(t, k, steps):
     return out
 
 
-def _combine(levels, weights):
-    """Σ w_i levels[m_i] (the level itself for one weight 1)."""
+def _combine(level, weights):
+    """Σ w_i level(m_i) (the level itself for one weight 1)."""
     if len(weights) == 1:
-        return levels[weights[0][0]]
+        return level(weights[0][0])
     (m0, w0), (m1, w1) = weights
-    return w0 * levels[m0] + w1 * levels[m1]
+    return w0 * level(m0) + w1 * level(m1)
 
 
 def _facet_lengths(mesh, facets):

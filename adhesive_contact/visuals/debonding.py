@@ -4,7 +4,8 @@
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..postprocess import debond_fronts, debonded_area, energies, energy_per_area
+from ..postprocess import (debond_fronts, debonded_area, energies, energy_per_area,
+                           new_debonding)
 from .common import AXES, Units, save_figure, solution_title
 from .levels import contact_axis
 from .energy import energy_label
@@ -47,10 +48,11 @@ def figure_debonding(solution, history=None):
     bx.set_ylabel(f"debonded {measure}" + units.suffix("length"))
     bx.legend(fontsize="small")
     bx.set_title("debonded", fontsize="medium")
-    if history is not None:
+    if history is not None:   # per the area the run debonded: a pre-crack dissipates nothing
         glue = history.dissipated["debonding"]
-        cx.plot(t, energy_per_area(glue, area), label=f"per {measure} with β < ½")
-        cx.plot(t, energy_per_area(glue, damage), "--", label="per ∫ (1 − β)")
+        new_area, new_damage = new_debonding(solution)
+        cx.plot(t, energy_per_area(glue, new_area), label=f"per {measure} debonded in the run")
+        cx.plot(t, energy_per_area(glue, new_damage), "--", label="per ∫ (β₀ − β)")
         cx.legend(fontsize="small")
     cx.set_xlabel(units.time)
     cx.set_ylabel(energy_label(units) + f" per unit debonded {measure}")

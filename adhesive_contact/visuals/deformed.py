@@ -67,8 +67,14 @@ def _face_values(solution, n, faces, stressed):
     mesh = solution.problem.mesh
     if stressed:
         return cell_von_mises(solution, n)[mesh.f2t[0, faces]]
-    u = np.linalg.norm(np.asarray(solution.u[n]), axis=1)
+    u = np.linalg.norm(solution.displacement(n), axis=1)
     return u[mesh.facets[:, faces]].mean(axis=0)
+
+
+def _with_fields(solution, levels):
+    """The field levels nearest to ``levels`` (a run written with
+    ``[output] every`` > 1 keeps the fields of some levels only), each once."""
+    return np.unique([solution.nearest_field_level(n) for n in levels])
 
 
 def _deformed_3d(fig, solution, factor, units):
@@ -88,7 +94,7 @@ def _deformed_3d(fig, solution, factor, units):
     axes = []
     for i, (n, value) in enumerate(zip(levels, values)):
         ax = fig.add_subplot(1, levels.size, i + 1, projection="3d")
-        p = mesh.p + factor * np.asarray(solution.u[n]).T
+        p = mesh.p + factor * solution.displacement(n).T
         polys = p[:, mesh.facets[:, faces]].transpose(2, 1, 0)
         colours = plt.cm.viridis(norm(floored(value, top)))
         ax.add_collection3d(Poly3DCollection(polys, facecolors=colours, edgecolors="k",
@@ -148,9 +154,9 @@ def figure_deformed(solution):
         ax.set_title(f"{solution_title(solution)}\ndeformed mesh at t = {solution.t[-1]:g}, "
                      f"{scale_text}", fontsize="medium")
         return fig
-    levels = thinned(plot_levels(solution), DEFORMED_LEVELS)
-    largest = max(levels, key=lambda n: float(np.abs(np.asarray(solution.u[n])).max()))
-    factor = magnification(mesh.p, np.asarray(solution.u[largest]))
+    levels = _with_fields(solution, thinned(plot_levels(solution), DEFORMED_LEVELS))
+    largest = max(levels, key=lambda n: float(np.abs(solution.displacement(n)).max()))
+    factor = magnification(mesh.p, solution.displacement(largest))
     if factor != 1.0:
         scale_text = f"displacements magnified ×{factor:g}"
     fig = plt.figure(figsize=(4.5 * levels.size + 1.0, 5.5), layout="constrained")

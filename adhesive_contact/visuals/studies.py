@@ -237,7 +237,8 @@ def figure_quantity_vs_size(document, title, units=None):
         left.axhline(reference, linestyle="--", color="0.5",
                      label=f"fine reference: {reference:.6g}")
     left.legend(fontsize="small", loc="best")
-    left.set_ylabel(name)
+    unit = document["quantity"].get("unit")
+    left.set_ylabel(f"{name} ({unit})" if unit else name)
     xe, ye = _positive(x, [r["err_q"] for r in rows])
     if ye.size:
         slope = _fmt(document["rates"].get("Q"), ".2f", "n/a")
@@ -246,7 +247,7 @@ def figure_quantity_vs_size(document, title, units=None):
         right.legend(fontsize="small", loc="best")
     else:
         right.text(0.5, 0.5, "no nonzero error", transform=right.transAxes, ha="center")
-    right.set_ylabel(f"|Q_h − Q_ref| of {name}")
+    right.set_ylabel(f"|Q_h − Q_ref| of {name}" + (f" ({unit})" if unit else ""))
     length, time = units.suffix("length"), units.suffix("time")
     label = {"h": f"mesh size h{length}", "k": f"time step k{time}",
              "hk": f"mesh size h{length} (k halved with h)"}[param]
