@@ -28,7 +28,7 @@ STEP_KEYS = {"t", "probes", "normal_force", "tangential_force", "beta_mean", "be
              "iterations", "residual", "reactions", "contact_force", "energy", "debonding",
              "peak_pressure", "peak_pressure_at", "stick_measure", "slip_measure"}
 SUMMARY_KEYS = {"schema", "scene", "source", "mesh", "run", "smallness", "warnings", "timings",
-                "linear", "resources", "output", "iterations", "energy", "steps"}
+                "linear", "bulk", "resources", "output", "iterations", "energy", "steps"}
 SMALLNESS_KEYS = {"m_A", "m_nu", "m_tau", "trace_constant_squared", "rhs", "holds", "c_1tau",
                   "existence_rhs", "existence_holds", "convexity_rhs", "trace_refine",
                   "trace_lower_estimate",
@@ -140,6 +140,8 @@ def test_summary_has_one_record_per_level(solved):
     assert summary["mesh"] == {"nodes": NPOINTS, "cells": NCELLS, "dofs": 2 * NPOINTS,
                                "free_dofs": 2 * NPOINTS - 18, "contact_facets": NFACETS,
                                "contact_nodes": 9}
+    assert summary["bulk"]["path"] == "kernels"   # P1 triangles: the kernels apply
+    assert "P1 kernels" in summary["bulk"]["reason"]
     timings = summary["timings"]
     assert set(timings) == {"assembly", "factorisation", "schur", "stepping", "contact_solve",
                             "total"}

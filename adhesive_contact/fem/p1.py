@@ -11,8 +11,11 @@ vector dofs (i, a) ↦ d·node_i + a and u = φ_i e_a:
 
 so the stiffness parts are exact with no quadrature at all, and are built
 from one array of element matrices and one sparse conversion each. The
-same quantities from scikit-fem's forms (:mod:`adhesive_contact.fem.assembly`)
-agree to round-off (a test); these kernels are several times faster.
+same quantities from scikit-fem's forms (:mod:`adhesive_contact.fem.forms`,
+the path :class:`~adhesive_contact.fem.assembly.Assembly` takes where these
+kernels do not apply) agree to round-off (tests/test_p1.py,
+tests/test_forms.py); these kernels assemble 1.6 (2D) to 6.5 (3D) times
+faster at 1e5 dofs (studies/bench/forms_vs_kernels.py).
 """
 
 import functools

@@ -81,6 +81,7 @@ def summary_document(solution, source=None, history=None, lines=None, field_leve
         "warnings": [str(w) for w in problem.warnings()] + list(lines),
         "timings": {key: json_number(value) for key, value in solution.timings.items()},
         "linear": dict(solution.linear),
+        "bulk": dict(problem.assembly.record),
         **({"adaptive": {key: json_number(v) if isinstance(v, float) else v
                          for key, v in solution.adaptive.items()}}
            if solution.adaptive is not None else {}),

@@ -64,11 +64,17 @@ from .checks import (
 from .problem import Problem
 
 
-def build_problem(scene):
-    """Discretise a scene: the stages of the module docstring, in order."""
+def build_problem(scene, bulk="auto"):
+    """Discretise a scene: the stages of the module docstring, in order.
+
+    ``bulk`` says how the bulk operators are built: "auto" (the vectorised
+    P1 kernels wherever they apply, every scene today), "kernels" or
+    "forms" (scikit-fem's assembly of :mod:`adhesive_contact.fem.forms`,
+    the reference: the same numbers to round-off);
+    :func:`~adhesive_contact.fem.assembly.choose_path`."""
     t0 = time.perf_counter()
     times = time_grid(scene)
-    mesh, assembly = mesh_and_dofs(scene)
+    mesh, assembly = mesh_and_dofs(scene, bulk)
     held = held_dofs(scene, mesh, assembly)
     if scene.memory is not None and scene.memory.kernel == "function":
         check_kernel("memory.r", scene.memory.function, times[1], times.size - 1)
@@ -82,7 +88,7 @@ def build_problem(scene):
     return Problem(scene=scene, mesh=mesh, assembly=assembly, free=held.free,
                    prescribed=held.prescribed, boundary=on_contact.boundary,
                    columns=on_contact.columns, contact_positions=on_contact.positions,
-                   loads=loads(scene, mesh, exact, held, times), gap=on_contact.gap,
+                   loads=loads(scene, mesh, exact, held, times, assembly), gap=on_contact.gap,
                    beta0=beta0, normal_law=laws.normal, friction=laws.friction,
                    bonding=laws.bonding, probe_map=probe_map, times=times,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
@@ -117,10 +123,11 @@ def time_grid(scene):
 # ---------------------------------------------------------------- 1. mesh and dofs
 
 
-def mesh_and_dofs(scene):
-    """The mesh with its named sides, and the operators assembled once on it."""
+def mesh_and_dofs(scene, bulk="auto"):
+    """The mesh with its named sides, and the operators assembled once on
+    it, by the path ``bulk`` (:class:`~adhesive_contact.fem.assembly.Assembly`)."""
     mesh = build_mesh(scene.mesh)
-    return mesh, Assembly(mesh)
+    return mesh, Assembly(mesh, path=bulk)
 
 
 # ---------------------------------------------------------------- 2. held dofs
@@ -333,11 +340,11 @@ def _side_normals_at(mesh, boundary):
 # ---------------------------------------------------------------- 7. loads
 
 
-def loads(scene, mesh, exact, held, times):
+def loads(scene, mesh, exact, held, times, assembly=None):
     """The :class:`~adhesive_contact.fem.assembly.LoadMap` of the body force
     and the surface tractions, checked finite where it is evaluated: the
     scene's ``[loads]``, or a manufactured solution's f_0, f_N on the
-    remaining sides and f_C on Γ_C."""
+    remaining sides and f_C on Γ_C; on the path of ``assembly``."""
     if exact is None:
         body = None if is_zero(scene.body) else vector_of(scene.body)
         surface = [(named_facets(mesh, [side], "loads.traction", indexed=False),
@@ -346,7 +353,7 @@ def loads(scene, mesh, exact, held, times):
                  [[(f"loads.body[{i}]", e) for i, e in enumerate(scene.body)]])
         keyed += [[(f"loads.traction.{side}[{i}]", e) for i, e in enumerate(exprs)]
                   for side, exprs in scene.traction.items()]
-        load_map = LoadMap(mesh, body, surface)
+        load_map = LoadMap(mesh, body, surface, assembly=assembly)
     else:
         neumann = np.setdiff1d(mesh.boundary_facets(),
                                np.concatenate([held.dirichlet_facets, held.contact_facets]))
@@ -357,7 +364,7 @@ def loads(scene, mesh, exact, held, times):
             normal = _load_point_normals(mesh, held.contact_facets)      # (d, npoints)
             tangents = tangent_frame(normal)[:, :, 1:].transpose(2, 1, 0)  # (d-1, d, npoints)
             surface.append((held.contact_facets, exact.contact_load(normal, tangents)))
-        load_map = LoadMap(mesh, exact.body_force, surface)
+        load_map = LoadMap(mesh, exact.body_force, surface, assembly=assembly)
         keyed = [[("exact", field)] for field, _ in load_map.parts]
     check_loads(keyed, load_map, times)
     return load_map
