@@ -392,3 +392,15 @@ class Listener:
         self.server.close()
         for conn in self.sockets:
             conn.close()
+
+
+def level_zero_input(problem, operators):
+    """The StepInput of level 0 of ``problem`` (t = 0, β_0, no history, z = 0)
+    on ``operators``, as the march builds it."""
+    from adhesive_contact.scheme.state import StepInput, history_load, initial_state
+
+    state = initial_state(problem)
+    b, known = history_load(problem, operators, True, 0.0, None)
+    gap = None if problem.gap is None else problem.gap.at(0.0)
+    return StepInput(index=0, t=0.0, k=0.0, b=b, known=known, beta=state.beta, gap=gap,
+                     gap_before=None, z0=state.z)

@@ -1,5 +1,5 @@
-"""Adaptive time steps, [time.adaptive] (scheme/adaptive, adaptive_memory,
-adaptive_loop; docs/scheme.md, "Adaptive time steps")."""
+"""Adaptive time steps, [time.adaptive] (scheme/adaptive, scheme/memory,
+scheme/controllers/step_doubling; docs/scheme.md, "Adaptive time steps")."""
 
 import json
 import math
@@ -13,9 +13,8 @@ from conftest import (DELETE, SLS_E_1, SLS_E_INF, assert_one_line_error, glued_c
 from adhesive_contact import scene_from_dict
 from adhesive_contact.problem.build import build_problem
 from adhesive_contact.scheme import solve
-from adhesive_contact.scheme import memory as uniform_memory
 from adhesive_contact.scheme.adaptive import Controller, PairNorm, StepSizes
-from adhesive_contact.scheme.adaptive_memory import FunctionMemory, PronyMemory, start_memory
+from adhesive_contact.scheme.memory import start_memory
 
 # ---------------------------------------------------------------- the controller
 
@@ -258,24 +257,6 @@ def test_nonuniform_memory_converges_to_the_integral_of_a_known_strain(rng, trap
     assert np.all(np.abs(rates - order) < 0.15), (errors, rates)
 
 
-@pytest.mark.parametrize("trapezoid", [False, True])
-def test_on_a_uniform_grid_it_is_the_uniform_memory(rng, trapezoid):
-    k, n, tau = 0.05, 30, np.array([0.2, 0.9])
-    u = rng.normal(size=(n + 1, 6))
-    old = uniform_memory.PronyMemory([1.0, 2.0], [0.5, -1.0], tau, trapezoid)
-    old.begin(k, 6)
-    new = PronyMemory(np.array([1.0, 2.0]), np.array([0.5, -1.0]), tau, trapezoid,
-                      np.zeros((2, 6)), u[0].copy() if trapezoid else None)
-    old.advance(0, u[0])
-    for m in range(1, n + 1):
-        h = new.decayed(k)
-        for a, b in zip(old.history(m), new.fields(h)):
-            np.testing.assert_allclose(a, b, rtol=1e-13, atol=1e-15)
-        old.advance(m, u[m])
-        new = new.after(h, u[m], k)
-    assert isinstance(new, PronyMemory) and not isinstance(new, FunctionMemory)
-
-
 # ---------------------------------------------------------------- runs
 
 
@@ -313,8 +294,8 @@ def test_an_adaptive_run_of_the_debonding_strip():
     assert sum(facts["step_sizes"].values()) == t.size - 1
     # one factorisation per quantised step used (the doubled steps included)
     assert len(facts["factorised_steps"]) <= scene.adaptive.halvings + 2
-    # the solution's problem is on the run's levels
-    assert solution.problem.times.shape == t.shape and solution.beta.shape[0] == t.size
+    # the solution's levels: their times, gaps and fields
+    assert solution.beta.shape[0] == t.size
     assert solution.gap_violation().shape == t.shape
     # the glue debonds: β falls to 0 somewhere
     assert solution.beta[-1].min() < 0.05 < solution.beta[0].min()
@@ -362,7 +343,7 @@ def test_solve_writes_the_nonuniform_grid(tmp_path):
     from adhesive_contact.io import load_solution
     loaded = load_solution(out)
     np.testing.assert_array_equal(loaded.t, t)
-    assert loaded.problem.times.size == t.size
+    assert loaded.beta.shape[0] == t.size
 
 
 def test_solve_and_check_say_the_steps_an_adaptive_run_took(tmp_path):

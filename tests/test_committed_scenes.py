@@ -46,7 +46,7 @@ def test_wall_scene_shows_wall_compliance_and_separation():
     un = solution.normal_displacement[-1]
     on_wall = solution.on_wall[-1]
     assert (on_wall.sum(), ((un > 0) & ~on_wall).sum(), (un < 0).sum()) == (13, 14, 38)
-    assert (solution.normal_displacement - solution.problem.gap).max() <= 1e-12
+    assert (solution.normal_displacement - solution.gap).max() <= 1e-12
 
 
 def test_readme_python_example_runs(monkeypatch):

@@ -206,7 +206,7 @@ def test_global_equilibrium_with_contact_and_memory():
         # the wall: u_ν ≤ g at every contact node
         u_nodes = sol.u[n][bnd.nodes]
         u_nu = np.sum(u_nodes * normals, axis=1)
-        g = problem.gap[n]
+        g = sol.gap[n]
         np.testing.assert_allclose(g, 0.004 + 0.004 * x[bnd.nodes] * (2 - x[bnd.nodes]),
                                    rtol=1e-14)
         assert np.all(u_nu <= g + 1e-10)

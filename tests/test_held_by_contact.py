@@ -12,7 +12,6 @@ from test_cli import run, strict_json
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.fem.dirichlet import rigid_modes
 from adhesive_contact.postprocess import applied_traction, total_contact_force
-from adhesive_contact.scheme.memory import start_memory
 from adhesive_contact.scheme.operators import StepOperators
 
 E, NU = 1000.0, 0.3          # the material of conftest.BLOCK (2 × 0.5, 16 × 4 cells)
@@ -106,7 +105,7 @@ def test_the_interior_is_regular_and_the_free_motion_is_the_kernel_of_S():
     translation (u_ν = −1 at every contact node) in its kernel, and no other
     direction of S is that small."""
     problem = build_problem(scene_from_dict(scene_dict(PRESSED)))
-    operators = StepOperators.build(problem, start_memory(problem))
+    operators = StepOperators.build(problem, problem.options.k)
     step = operators.step
     A = problem.assembly.stiffness(problem.scene.material.lam, problem.scene.material.mu)
     R = operators.rotation                    # the nodal frames of Γ_C

@@ -14,7 +14,7 @@ import pytest
 from conftest import law, prony, scene_dict
 
 from adhesive_contact import build_problem, scene_from_dict, solve
-from adhesive_contact.scheme.memory import start_memory
+from adhesive_contact.scheme.memory import step_tensor
 from adhesive_contact.scheme.operators import StepOperators, contraction
 
 # the strip of conftest.BLOCK pressed onto a wall, sheared, for 3 steps
@@ -31,7 +31,7 @@ STRONG = prony((30000.0, 0.3, 0.2))
 def test_initial_state_with_memory_equals_the_elastic_problem(friction, memory, proximal):
     changes = {**CHANGES, "contact.friction": friction} if friction else CHANGES
     problem = build_problem(scene_from_dict(scene_dict({**changes, "memory": memory})))
-    operators = StepOperators.build(problem, start_memory(problem))
+    operators = StepOperators.build(problem, problem.options.k)
     assert (operators.shift is not None) == proximal
     assert (operators.initial is operators.step) == proximal
     with_memory = solve(problem)
@@ -58,9 +58,9 @@ def test_contraction_bounds_the_spectral_radius(dim):
         changes.update({"dim": 3, "mesh.domain": "box", "mesh.size": [2.0, 1.0, 1.0],
                         "mesh.cells": [4, 2, 2], "loads.body": ["0", "-400", "0"]})
     problem = build_problem(scene_from_dict(scene_dict(changes)))
-    memory = start_memory(problem)
     material, k = problem.scene.material, problem.scene.k
-    elastic, shift = (material.lam, material.mu), memory.instantaneous(k)
+    elastic = (material.lam, material.mu)
+    shift = step_tensor(problem.options.memory, problem.options.second_order, k)
     free = problem.free
     A = problem.assembly.stiffness(*elastic)[free][:, free].toarray()
     D = problem.assembly.stiffness(*shift)[free][:, free].toarray()
@@ -75,18 +75,17 @@ def test_a_proximal_iteration_that_does_not_settle_is_a_failed_step():
     """Told a contraction far below the true one, the t = 0 iteration runs
     out of its 14 solves (ρ ≈ 0.27 needs about 25) and the step fails with
     what it reached and what to try, not with an unconverged u."""
-    from adhesive_contact.scheme.state import ContactStep, initial_state, proximal_solve, step_load
+    from adhesive_contact.scheme.state import ContactStep, proximal_solve
     from adhesive_contact.step_methods import MAX_ITERATIONS
+    from conftest import level_zero_input
 
     problem = build_problem(scene_from_dict(scene_dict({**CHANGES,
                                                         "memory": prony((1200.0, 0.3, 0.2))})))
-    memory = start_memory(problem)
-    operators = StepOperators.build(problem, memory)
+    operators = StepOperators.build(problem, problem.options.k)
     assert operators.shift is not None and 0.2 < operators.contraction <= 0.3
-    state = initial_state(problem, memory)
-    b, _ = step_load(problem, operators, state, 0, 0.0)
+    step = level_zero_input(problem, operators)
     contact = ContactStep(problem)
-    args = (operators.step, operators.shift, contact, 0, b, problem.beta0, state.z)
+    args = (operators.step, operators.shift, contact, step)
     u, *_, result = proximal_solve(*args, contraction=operators.contraction)
     assert u is not None and result.success
     u, *_, result = proximal_solve(*args, contraction=1e-3)

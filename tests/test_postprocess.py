@@ -192,7 +192,7 @@ def test_without_a_compliant_layer_touching_is_the_wall():
         **{k: SCENE[k] for k in ("mesh", "time")}, "boundary.dirichlet": ["top"],
         "contact": {"gap": "0.002", "normal": law("none")}})))
     nc = problem.boundary.nodes.size
-    gap = problem.gap[0]
+    gap = problem.gap.at(0.0)
     z = np.zeros((nc, 2))
     z[:, 0] = 0.5 * gap                      # short of the wall
     z[3, 0] = gap[3] - 1e-12                 # at the wall, not in the set
@@ -206,7 +206,7 @@ def test_without_a_compliant_layer_touching_is_the_wall():
     assert not masks["compliance"].any()
     # the same from a solution: the measure in contact
     fake = SimpleNamespace(problem=problem, t=np.zeros(1), frame_displacement=z[None],
-                           on_wall=wall[None], stuck=wall[None])
+                           on_wall=wall[None], stuck=wall[None], gap=gap[None])
     assert contact_measure(fake)[0] == pytest.approx(problem.boundary.node_weights[[3, 4]].sum())
 
 

@@ -7,21 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import scene_dict
+from conftest import level_zero_input, scene_dict
 
 from adhesive_contact import SceneError, build_problem, parse_scene, scene_from_dict, solve
 from adhesive_contact.verification.levels import with_discretisation
 from adhesive_contact.scheme import STEP_FAILED, InvalidState
 from adhesive_contact.scheme.level_checks import check_level
-from adhesive_contact.scheme.memory import start_memory
 from adhesive_contact.scheme.operators import StepOperators
-from adhesive_contact.scheme.state import (
-    ContactStep,
-    bonding_step,
-    initial_state,
-    step_load,
-    step_solve,
-)
+from adhesive_contact.scheme.state import ContactStep, step_solve
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,13 +26,9 @@ def debonding(steps):
 
 def first_level(problem):
     """Level 0 of a run, computed step by step with the scheme's functions."""
-    memory = start_memory(problem)
-    operators = StepOperators.build(problem, memory)
-    state = initial_state(problem, memory)
-    b, history = step_load(problem, operators, state, 0, 0.0)
-    level, *_ = step_solve(problem, operators, ContactStep(problem), 0, 0.0, b,
-                           bonding_step(problem, state), history, state.z)
-    return level
+    operators = StepOperators.build(problem, problem.options.k)
+    step = level_zero_input(problem, operators)
+    return step_solve(problem, operators, ContactStep(problem), step).level
 
 
 def test_explicit_euler_beyond_its_bound_stops_with_the_figures():
@@ -89,7 +78,7 @@ def test_a_level_beyond_the_wall_is_named():
     assert check_level(problem, level) is None
     moved = level.frame_displacement.copy()
     a = 3
-    moved[a, 0] = problem.gap[0, a] + 1e-3
+    moved[a, 0] = problem.gap.at(0.0)[a] + 1e-3
     failure = check_level(problem, dataclasses.replace(level, frame_displacement=moved))
     x = problem.mesh.p[:, problem.boundary.nodes[a]]
     assert isinstance(failure, InvalidState)

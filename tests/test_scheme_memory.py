@@ -12,6 +12,23 @@ from scipy.integrate import quad
 from adhesive_contact import compile_expression
 from adhesive_contact.scheme.memory import FunctionMemory, PronyMemory
 
+
+def uniform(memory, k, us):
+    """The histories (a_λ, a_μ) (or None) of steps n = 1..len(us) of k with
+    the persistent ``memory`` (started after level 0), u_n = us[n − 1]."""
+    out = []
+    for u in us:
+        h = memory.decayed(k)
+        out.append(memory.fields(h))
+        memory = memory.after(h, u, k)
+    return out
+
+
+def prony_memory(lam, mu, tau, ndofs, trapezoid=False, u0=None):
+    lam, mu, tau = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (lam, mu, tau))
+    return PronyMemory(lam, mu, tau, trapezoid, np.zeros((tau.size, ndofs)),
+                       None if not trapezoid else u0)
+
 # --------------------------------------------------------------------------
 # The history sums
 # --------------------------------------------------------------------------
@@ -26,12 +43,12 @@ def test_prony_recursion_equals_direct_sum(rng):
     lam, mu, tau = np.array([120.0, 30.0]), np.array([80.0, 45.0]), np.array([0.3, 2.0])
     k, steps, ndofs = 0.02, 50, 40
     us = rng.standard_normal((steps, ndofs))
-    mem = PronyMemory(lam, mu, tau)
-    mem.begin(k, ndofs)
+    mem = prony_memory(lam, mu, tau, ndofs)
     np.testing.assert_allclose(mem.instantaneous(k), (k * lam.sum(), k * mu.sum()), rtol=1e-15)
+    histories = uniform(mem, k, us)
     for n in range(1, steps + 1):
         h = direct_history(k, tau, us, n)
-        a_lam, a_mu = mem.history(n)
+        a_lam, a_mu = histories[n - 1]
         ref_lam, ref_mu = lam @ h, mu @ h
         if n == 1:
             assert np.abs(a_lam).max() == 0.0 and np.abs(a_mu).max() == 0.0
@@ -41,7 +58,6 @@ def test_prony_recursion_equals_direct_sum(rng):
             # like n ε_mach ≈ 1e-14 relative: 1e-12 leaves a margin of 100.
             assert relative_max(a_lam, ref_lam) < 1e-12
             assert relative_max(a_mu, ref_mu) < 1e-12
-        mem.advance(n, us[n - 1])
 
 
 def test_function_kernel_equals_single_prony_term(rng):
@@ -49,21 +65,16 @@ def test_function_kernel_equals_single_prony_term(rng):
     lam, mu, tau = 70.0, 35.0, 0.3
     k, steps, ndofs = 0.02, 50, 30
     us = rng.standard_normal((steps, ndofs))
-    prony = PronyMemory([lam], [mu], [tau])
-    func = FunctionMemory(compile_expression("exp(-t/0.3)"), lam, mu)
-    prony.begin(k, ndofs)
-    func.begin(k, ndofs)
+    prony = prony_memory([lam], [mu], [tau], ndofs)
+    func = FunctionMemory(compile_expression("exp(-t/0.3)"), lam, mu, False, 0.0)
     np.testing.assert_allclose(func.instantaneous(k), prony.instantaneous(k), rtol=1e-15)
-    for n in range(1, steps + 1):
-        hp, hf = prony.history(n), func.history(n)
+    for n, (hp, hf) in enumerate(zip(uniform(prony, k, us), uniform(func, k, us)), start=1):
         if hf is None:      # no history yet (n = 1)
             assert n == 1 and np.abs(hp[0]).max() == 0.0
         else:
             # Tolerance: round-off of two 50-term sums (see above).
             assert relative_max(hf[0], hp[0]) < 1e-12
             assert relative_max(hf[1], hp[1]) < 1e-12
-        prony.advance(n, us[n - 1])
-        func.advance(n, us[n - 1])
 
 
 # --------------------------------------------------------------------------

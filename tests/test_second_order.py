@@ -31,7 +31,8 @@ from scipy.integrate import solve_ivp
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.laws import Fremond
 from adhesive_contact.scheme.bonding import FacetRate, advance
-from adhesive_contact.scheme.memory import FunctionMemory, PronyMemory
+from adhesive_contact.scheme.memory import FunctionMemory
+from test_scheme_memory import prony_memory, uniform
 from adhesive_contact import compile_expression
 from adhesive_contact.verification.levels import run_level, run_reference
 
@@ -61,37 +62,34 @@ def test_trapezoidal_prony_recursion_equals_the_trapezoidal_sum(rng):
     lam, mu, tau = np.array([120.0, 30.0]), np.array([80.0, 45.0]), np.array([0.3, 2.0])
     k, steps, ndofs = 0.02, 50, 40
     us = rng.standard_normal((steps + 1, ndofs))   # u_0 .. u_N
-    mem = PronyMemory(lam, mu, tau, trapezoid=True)
-    mem.begin(k, ndofs)
+    mem = prony_memory(lam, mu, tau, ndofs, trapezoid=True, u0=us[0])
     # the j = n weight is k/2
     np.testing.assert_allclose(mem.instantaneous(k), (0.5 * k * lam.sum(), 0.5 * k * mu.sum()),
                                rtol=1e-15)
-    mem.advance(0, us[0])
+    histories = uniform(mem, k, us[1:])
     for n in range(1, steps + 1):
         h = np.array([trapezoidal_sum(k, lambda t, tau=t_: np.exp(-t / tau), us, n)
                       for t_ in tau])
-        a_lam, a_mu = mem.history(n)
+        a_lam, a_mu = histories[n - 1]
         # Tolerance: sums of ≤ 50 terms of size ~k|u|, round-off ~n ε_mach (as
         # tests/test_scheme_memory.py): 1e-12 leaves a margin of 100
         scale = np.abs(lam @ h).max()
         assert np.abs(a_lam - lam @ h).max() < 1e-12 * scale
         assert np.abs(a_mu - mu @ h).max() < 1e-12 * np.abs(mu @ h).max()
-        mem.advance(n, us[n])
 
 
 def test_trapezoidal_general_kernel_equals_the_trapezoidal_sum(rng):
     lam, mu, k, steps, ndofs = 70.0, 35.0, 0.05, 30, 12
     us = rng.standard_normal((steps + 1, ndofs))
-    func = FunctionMemory(compile_expression("1/(1 + t)**2"), lam, mu, trapezoid=True)
-    func.begin(k, ndofs)
+    func = FunctionMemory(compile_expression("1/(1 + t)**2"), lam, mu, True, 0.0, (0.0,),
+                          (0.0,), (us[0].copy(),))
     np.testing.assert_allclose(func.instantaneous(k), (0.5 * k * lam, 0.5 * k * mu), rtol=1e-15)
-    func.advance(0, us[0])
+    histories = uniform(func, k, us[1:])
     for n in range(1, steps + 1):
         ref = trapezoidal_sum(k, lambda t: 1.0 / (1.0 + t) ** 2, us, n)
-        a_lam, a_mu = func.history(n)
+        a_lam, a_mu = histories[n - 1]
         assert np.abs(a_lam - lam * ref).max() < 1e-12 * np.abs(lam * ref).max()
         assert np.abs(a_mu - mu * ref).max() < 1e-12 * np.abs(mu * ref).max()
-        func.advance(n, us[n])
 
 
 def test_trapezoidal_memory_is_second_order_for_a_closed_form_integral():
@@ -104,11 +102,8 @@ def test_trapezoidal_memory_is_second_order_for_a_closed_form_integral():
     for trapezoid in (True, False):
         for N in (10, 20, 40, 80):
             k = 1.0 / N
-            mem = PronyMemory([1.0], [0.0], [tau], trapezoid=trapezoid)
-            mem.begin(k, 1)
-            for n in range(N):
-                mem.advance(n, np.array([n * k]))
-            a_lam, _ = mem.history(N)
+            mem = prony_memory([1.0], [0.0], [tau], 1, trapezoid, np.array([0.0]))
+            a_lam, _ = uniform(mem, k, [np.array([n * k]) for n in range(1, N + 1)])[-1]
             value = a_lam[0] + mem.instantaneous(k)[0] * 1.0   # + w R(0) u(1)
             errs[trapezoid].append(abs(value - exact))
     assert np.all(np.abs(rates(errs[True]) - 2.0) < 0.05)

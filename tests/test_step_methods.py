@@ -19,7 +19,6 @@ from test_cli import strict_json
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.scheme import STEP_FAILED
 from adhesive_contact.scheme.level_checks import WALL_SLACK, check_level
-from adhesive_contact.scheme.memory import start_memory
 from adhesive_contact.step_methods import (
     MAX_ITERATIONS,
     METHODS,
@@ -108,6 +107,7 @@ def test_the_wall_check_still_applies_to_the_exact_methods():
         n, t = 2, sol.t[2]           # the wall is reached at t = 1
         u, beta, stress = sol.u[2], sol.beta[2], sol.stress[2]
         frame_displacement = sol.frame_displacement[2]
+        gap, k = sol.gap[2], sol.t[1]
 
     assert check_level(problem, Level) is None
     failure = check_level(exact_problem, Level)
@@ -184,15 +184,15 @@ def test_slip_weakening_each_method_reports_how_it_ended():
 def test_the_interface_and_the_old_import_agree():
     problem, sol = run("newton", (TRESCA,), SHEAR, steps=1)
     from adhesive_contact.scheme.operators import StepOperators
-    ops = StepOperators.build(problem, start_memory(problem))
-    step = ops.at(1)
+    ops = StepOperators.build(problem, problem.options.k)
+    step = ops.at(False)
     c = step.reduce(ops.to_frames(problem.loads(1.0)))
     from adhesive_contact.scheme.state import ContactStep
     contact = ContactStep(problem)
     contact.energy.set_bonding(problem.beta0)
     contact.kink.radius = contact.energy.node_kink(problem.boundary.point_node,
                                                    problem.boundary.nodes.size)
-    z0, upper = np.zeros(c.size), problem.upper_bound(1)
+    z0, upper = np.zeros(c.size), problem.upper_bound(None)
     new = minimise("newton", step.S, c, contact.energy, upper, z0, StepOptions(), contact.kink)
     old = minimise_step(step.S, c, contact.energy, upper, z0, kink=contact.kink)
     assert new.success and np.array_equal(new.z, old.z) and new.nit == old.nit

@@ -151,7 +151,7 @@ def test_grid_sweep_rows_match_direct_solves_and_failures_are_rows(grid_sweep):
         un = solution.frame_displacement[:, :, 0]
         assert int(row["separated_T"]) == (un[-1] < 0).sum()
         assert float(row["max_un_minus_g"]) == pytest.approx(
-            (un - problem.gap).max(), abs=1e-15)
+            (un - solution.gap).max(), abs=1e-15)
         # the held side's reaction: its peak (largest magnitude, signed) and at T
         held = reactions(solution)[:, 0, :]
         for c, axis in enumerate("xy"):

@@ -11,7 +11,6 @@ gives the problem); ``solution.npz`` gives every array
 
 import json
 import zipfile
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -180,8 +179,7 @@ def load_solution(folder, problem=None):
     if not np.array_equal(arrays["points"], problem.mesh.p.T):
         raise OutputFolderError(npz_path, "holds another mesh than the problem's")
     zz = arrays.get("stress_zz_last")
-    if problem.scene.adaptive is not None and problem.times.size != arrays["t"].size:
-        problem = on_levels(problem, arrays["t"])
+    gap = None if problem.gap is None else problem.gap.levels(arrays["t"])
     return Solution(
         problem=problem, status=STATUS_CODES[run["status"]], message=run["message"], failure=None,
         t=arrays["t"], u=arrays["u"], beta=arrays["beta"],
@@ -189,7 +187,7 @@ def load_solution(folder, problem=None):
         contact_force=arrays["contact_force"],
         frame_displacement=arrays["frame_displacement"], on_wall=arrays["on_wall"],
         stuck=arrays["stuck"], probes=arrays["probes"], iterations=arrays["iterations"],
-        residual=arrays["residual"], reaction=arrays["held_reaction"],
+        residual=arrays["residual"], reaction=arrays["held_reaction"], gap=gap,
         timings={k: (float("nan") if v is None else v)
                  for k, v in document.get("timings", {}).items()},
         linear=dict(document.get("linear", {})), adaptive=document.get("adaptive"),
@@ -241,12 +239,3 @@ def array_headers_or_error(path, names):
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
         raise OutputFolderError(path, f"cannot be read ({type(err).__name__}: {err}): the "
                                 "file is damaged; run the scene again") from None
-
-
-def on_levels(problem, t):
-    """An adaptive run's problem (built on the grid m k_min) with the times
-    ``t`` of its levels and their gaps, as the run returned it."""
-    k_min = problem.scene.adaptive.k_min
-    index = np.rint(np.asarray(t) / k_min).astype(np.int64)
-    return replace(problem, times=np.asarray(t, dtype=float).copy(),
-                   gap=None if problem.gap is None else np.ascontiguousarray(problem.gap[index]))

@@ -30,8 +30,8 @@ from .h5 import H5File
 from .xdmf import XdmfSeries
 
 #: kept per level in memory (small), as in HistoryRecorder
-SMALL = ("beta", "contact_force", "frame_displacement", "on_wall", "stuck", "probes",
-         "reaction", "iterations", "residual")
+SMALL = ("t", "gap", "beta", "contact_force", "frame_displacement", "on_wall", "stuck",
+         "probes", "reaction", "iterations", "residual")
 SCRATCH = ".levels.h5"
 
 
@@ -88,7 +88,9 @@ class StreamingRecorder:
             self.u.resize(2 * self.u.shape[0], axis=0)
         self.u[level.n] = level.u
         for name in SMALL:
-            self.small[name].append(np.asarray(getattr(level, name)))
+            value = getattr(level, name)
+            if value is not None:
+                self.small[name].append(np.asarray(value))
         write, keep, drop = self.chooser.offer(
             level.n, reported_forces(self.problem, level.reaction, level.contact_force))
         for n in drop:
@@ -114,6 +116,8 @@ class StreamingRecorder:
         out = {name: (np.stack(values) if values else np.zeros((0, *self.empty[name][0]),
                                                                  dtype=self.empty[name][1]))
                for name, values in self.small.items()}
+        if self.problem.gap is None:
+            out["gap"] = None
         out["u"] = DiskLevels(self.u, self.count)
         last = self.last
         out["stress"] = None if last is None else last.stress[None]
@@ -138,7 +142,8 @@ def _empty_shapes(problem):
     nc = 0 if boundary is None else boundary.nodes.size
     nf = 0 if boundary is None else boundary.facets.size
     nprobes = 0 if problem.probe_map is None else problem.probe_map.shape[0]
-    return {"beta": ((nf,), float), "contact_force": ((nc, d), float),
+    return {"t": ((), float), "gap": ((nc,), float),
+            "beta": ((nf,), float), "contact_force": ((nc, d), float),
             "frame_displacement": ((nc, d), float), "on_wall": ((nc,), bool),
             "stuck": ((nc,), bool), "probes": ((nprobes, d), float),
             "reaction": ((problem.prescribed.fixed.size,), float), "iterations": ((), int),

@@ -128,7 +128,7 @@ def run_record(solution):
     return {
         "success": bool(solution.success),
         "status": STATUS[solution.status],
-        "partial": bool(solution.t.size < solution.problem.times.size
+        "partial": bool(solution.t.size < solution.problem.options.steps + 1
                         if solution.adaptive is None else not solution.success),
         "levels": int(solution.t.size),
         "message": " ".join(solution.message.split()),

@@ -164,9 +164,7 @@ class XdmfSeries:
         """The contact fields of a level at the points of ``contact.xdmf``
         (every vertex of Γ_C is a contact node; along a held component
         the force is the contact laws' there)."""
-        at = getattr(level, "index", None)   # an adaptive run: its index on a finer grid
-        at = level.n if at is None else at
-        gap = None if self.problem.gap is None else self.problem.gap[at]
+        gap = getattr(level, "gap", None)
         fields = contact_fields(self.problem, level.contact_force, level.frame_displacement,
                                 level.on_wall, level.stuck, gap)
         fields["on_wall"] = np.asarray(level.on_wall, dtype=float)
@@ -201,6 +199,7 @@ class _LevelOf:
         self.contact_force = solution.contact_force[n]
         self.frame_displacement = solution.frame_displacement[n]
         self.on_wall, self.stuck = solution.on_wall[n], solution.stuck[n]
+        self.gap = None if solution.gap is None else solution.gap[n]
         self.stress = solution.stress[n]
         self.stress_zz = None if solution.stress_zz is None else solution.stress_zz[n]
 

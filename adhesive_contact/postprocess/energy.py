@@ -264,9 +264,9 @@ def contact_energies(solution):
     debonding = potentials.total(beta_old, z_old) - at_old
     force = solution.contact_force.reshape(levels, -1).T
     wall = np.zeros(levels)
-    gap = problem.gap
+    gap = solution.gap
     if gap is not None and gap.shape[1]:
-        g = gap[:levels]
+        g = gap
         dg = np.diff(g, axis=0, prepend=g[:1])                             # g_{−1} = g_0
         dg = np.where(np.isfinite(dg), dg, 0.0)
         if np.any(dg != 0.0):

@@ -197,7 +197,7 @@ def penetration(solution):
     outside the (convex) foundation."""
     problem = solution.problem
     foundation = problem.scene.contact.foundation
-    if foundation is None or problem.gap is None or problem.gap.shape[1] == 0:
+    if foundation is None or solution.gap is None or solution.gap.shape[1] == 0:
         return solution.gap_violation()
     boundary = problem.boundary
     levels, nc, d = solution.frame_displacement.shape

@@ -79,8 +79,7 @@ def state_masks(problem, frame_displacement, on_wall, stuck, gap=None):
 
 
 def _gap_of(solution):
-    gap = solution.problem.gap
-    return None if gap is None else gap[:solution.t.size]
+    return solution.gap
 
 
 def contact_states(solution):

@@ -10,7 +10,8 @@ its part of the :class:`~.problem.Problem`:
 3. :func:`contact_laws`: the normal law, the friction and the bonding law;
 4. :func:`manufactured_solution`: for a scene with [exact], its derived data;
 5. :func:`contact`: Γ_C (only if the scene has contact terms), the step's
-   unknowns and the gap at the contact nodes for every t_n;
+   unknowns and the gap at the contact nodes (:class:`~.gap.Gap`, checked
+   at every time of the run's grid);
    :func:`restraint`: no rigid motion left free by the held sides and the
    contact terms together;
 6. :func:`initial_bonding`: β_0^h = P_B β_0 (and the source s_β of a
@@ -61,6 +62,7 @@ from .checks import (
     free_rigid_motions,
     restraining_rows,
 )
+from .gap import Gap
 from .problem import Problem
 
 
@@ -90,7 +92,7 @@ def build_problem(scene, bulk="auto"):
                    columns=on_contact.columns, contact_positions=on_contact.positions,
                    loads=loads(scene, mesh, exact, held, times, assembly), gap=on_contact.gap,
                    beta0=beta0, normal_law=laws.normal, friction=laws.friction,
-                   bonding=laws.bonding, probe_map=probe_map, times=times,
+                   bonding=laws.bonding, probe_map=probe_map,
                    assembly_seconds=time.perf_counter() - t0, exact=exact,
                    beta_source=beta_source, held_by_contact=held_by_contact,
                    options=scheme_options(scene),
@@ -208,7 +210,7 @@ class Contact:
     boundary: object          # ContactBoundary, or None
     columns: np.ndarray       # the step's unknowns among the nc·d frame components
     positions: np.ndarray     # positions of those unknowns within ``free``
-    gap: np.ndarray           # (N+1, nc) g(x_a, t_n), or None for no wall
+    gap: object               # the Gap at the contact nodes, or None for no wall
 
 
 def contact(scene, mesh, assembly, held, laws, times):
@@ -260,7 +262,7 @@ def restraint(scene, mesh, held, laws, on_contact):
         check_rigid_motions(mesh, fixed, sides)
         return ()
     normal = bool(laws.normal.active)
-    wall = (np.isfinite(on_contact.gap).any(axis=0) if on_contact.gap is not None
+    wall = (on_contact.gap.somewhere if on_contact.gap is not None
             else np.zeros(boundary.nodes.size, dtype=bool))
     tangential = laws.friction is not None
     terms = [name for name, acts in (("a normal law", normal), ("a wall", wall.any()),
@@ -273,11 +275,12 @@ def restraint(scene, mesh, held, laws, on_contact):
 
 
 def gap_at_nodes(scene, mesh, boundary, times):
-    """g(x_a, t_n) (N+1, nc) at the contact nodes: the scene's gap
+    """The :class:`~.gap.Gap` of the contact nodes: the scene's gap
     expression, or the distance d_F(x_a) to the foundation
     (:mod:`~adhesive_contact.fem.foundation`), measured along the frame
     normal ν_a where held components turned ν_a off the foundation's
-    normal (+∞ where that misses it)."""
+    normal (+∞ where that misses it); checked finite and ≥ 0 at every
+    time of ``times`` (the grid the run's levels lie on)."""
     x = mesh.p[:, boundary.nodes]
     if scene.contact.foundation is not None:
         nu = boundary.frame[:, :, 0].T
@@ -285,18 +288,15 @@ def gap_at_nodes(scene, mesh, boundary, times):
         check_outside_foundation(x, depth)
         check_foundation_beside_body(scene.contact.foundation, mesh, signed_distance)
         own = np.all(nu == foundation_normal(scene.contact.foundation, x)[0], axis=0)
-        g = np.where(own, np.maximum(depth, 0.0), along)
-        if scene.adaptive is not None:   # N 2^J rows of one: a read-only view
-            return np.broadcast_to(g, (times.size, g.size))
-        return np.broadcast_to(g, (times.size, g.size)).copy()
-    if scene.adaptive is not None and not scene.contact.gap.depends_on_time:
+        return Gap(values=np.where(own, np.maximum(depth, 0.0), along))
+    if not scene.contact.gap.depends_on_time:
         gap = np.asarray(scene.contact.gap(*coordinates(x), t=0.0), dtype=float)
-        gap = np.broadcast_to(gap, (x.shape[1],))
+        gap = np.broadcast_to(gap, (x.shape[1],)).copy()
         check_gap(gap[None], x, times[:1])
-        return np.broadcast_to(gap, (times.size, gap.size))
-    gap = np.array([scene.contact.gap(*coordinates(x), t=t) for t in times])
-    check_gap(gap, x, times)
-    return gap
+        return Gap(values=gap)
+    field = Gap(expression=scene.contact.gap, x=x)
+    check_gap(field.levels(times), x, times)
+    return field
 
 
 # ---------------------------------------------------------------- 6. initial bonding

@@ -30,13 +30,12 @@ class Problem:
     columns: np.ndarray       # the step's unknowns among the nc·d frame components
     contact_positions: np.ndarray  # positions of those unknowns within ``free``
     loads: LoadMap
-    gap: np.ndarray           # (N+1, nc) g(x_a, t_n), or None for no wall
+    gap: object               # Gap: g(x_a, t) at the contact nodes (.at(t)), or None: no wall
     beta0: np.ndarray         # (nf,) β_0^h
     normal_law: object
     friction: object          # FrictionSum or None
     bonding: object           # bonding law or None (β frozen)
     probe_map: object         # sparse (nprobes, npoints) or None
-    times: np.ndarray         # t_n, n = 0..N
     assembly_seconds: float
     exact: object = None      # ManufacturedSolution, for scenes with [exact]
     beta_source: object = None  # s_β(x, y, z, t) at Γ_C (manufactured scenes)
@@ -82,10 +81,11 @@ class Problem:
         """Positions within the step's unknowns of the normal components."""
         return np.flatnonzero(self.columns % self.dim == 0)
 
-    def upper_bound(self, n):
-        """Bounds on z for step n: g at the normal unknowns, +inf elsewhere."""
+    def upper_bound(self, gap):
+        """Bounds on z for a step whose gap at the contact nodes is ``gap``
+        (nc,) (None: no wall): g at the normal unknowns, +inf elsewhere."""
         upper = np.full(self.columns.size, np.inf)
-        if self.gap is not None:
+        if gap is not None:
             normal = self.normal_columns
-            upper[normal] = self.gap[n][self.columns[normal] // self.dim]
+            upper[normal] = gap[self.columns[normal] // self.dim]
         return upper

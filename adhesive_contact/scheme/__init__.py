@@ -4,10 +4,12 @@
   frame rotation and the condensed step matrices, :mod:`.condensed`);
 - :mod:`.state`: the state of level n and the functions that advance it,
   one per equation: the bonding step (4.2), the step load with the memory
-  history, the step solve (4.1);
+  history (:mod:`.memory`), the step solve (4.1);
+- :mod:`.march`: the one time march, level by level, for any step
+  controller (:mod:`.controllers`: uniform steps, step doubling);
 - :mod:`.recorder`: what is kept of each level;
-- :mod:`.loop`: the time loop, :func:`solve`;
-- :mod:`.checks`: what every level must satisfy (no quiet wrong answers);
+- :mod:`.loop`: :func:`solve`, the march with the problem's controller;
+- :mod:`.level_checks`: what every level must satisfy (no quiet wrong answers);
 - :mod:`.solution`: what a run returns, :class:`Solution`.
 """
 

@@ -4,7 +4,7 @@ docs/scheme.md, "Adaptive time steps").
 Steps are quantised: h = k_max 2^{−j}, j = j_0..J, k_max = T/N, k_min =
 k_max 2^{−J}, so that every level lies on the grid t_m = m k_min and the
 step matrices A + h R(0) (and A + 2h R(0) of the doubled step) are
-factorised once per j that the run uses (:mod:`.adaptive_loop`).
+factorised once per j that the run uses (:mod:`.controllers.step_doubling`).
 Positions are counted in units of k_min (integers: no drift of t).
 
 The local error of a pair of half steps h is estimated by step doubling,

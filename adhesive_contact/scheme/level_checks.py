@@ -72,7 +72,7 @@ def check_level(problem, level):
                   f"{_facet_midpoint(problem, facet)}")
         bonding = problem.bonding
         if bonding is not None and problem.options.integrator == "explicit":
-            k, bound = problem.options.k, bonding.stable_step()
+            k, bound = (level.k or problem.options.k), bonding.stable_step()
             reason += (f". The explicit Euler step of the bonding law keeps beta in [0, 1] "
                        f"only for k (gamma_nu + gamma_tau) L^2 <= 1, i.e. k <= {bound:.4g}; "
                        f"this run has k = {k:.4g}")
@@ -82,15 +82,15 @@ def check_level(problem, level):
                            f"{BEYOND_TIME_SCALE} "
                            f"(docs/scheme.md#accuracy-guides-of-the-time-step)")
         return InvalidState(n, t, reason)
-    gap = problem.gap
+    gap = level.gap
     exact = problem.options.solver.method in EXACT
     if exact and gap is not None and level.frame_displacement.shape[0]:
         u_nu = level.frame_displacement[:, 0]
         # the wall acts where u_ν is free: a held u_ν is the scene's to set
-        excess = np.where(problem.boundary.held[:, 0], -np.inf, u_nu - gap[n])
+        excess = np.where(problem.boundary.held[:, 0], -np.inf, u_nu - gap)
         worst = int(np.argmax(excess))
-        finite = np.isfinite(gap[n])   # +inf: no wall at the node
-        scale = 1.0 + max(np.abs(gap[n][finite]).max(initial=0.0), np.abs(u_nu).max())
+        finite = np.isfinite(gap)   # +inf: no wall at the node
+        scale = 1.0 + max(np.abs(gap[finite]).max(initial=0.0), np.abs(u_nu).max())
         if excess[worst] > WALL_SLACK * scale:
             x = problem.mesh.p[:, problem.boundary.nodes[worst]]
             return InvalidState(n, t, (

@@ -34,6 +34,7 @@ import scipy.sparse as sp
 from ..linear_solvers import choose, make_linear_solver
 from .condensed import CondensedOperator, DenseSchur, PartialCondensation
 from .full_system import FullSystemOperator
+from .memory import step_tensor
 
 #: the step methods that iterate on all free dofs with AMG (scheme/full_system.py).
 #: The others get a Schur complement formed by one AMG-CG solve per contact
@@ -81,12 +82,12 @@ class StepOperators:
         return record
 
     @classmethod
-    def build(cls, problem, memory, k=None, initial=True):
-        """Factorise and condense the step matrices of ``problem`` with the
-        instantaneous tensor k R(0) of ``memory`` (k = T/N, or the step
-        ``k`` of an adaptive run); without ``initial`` the t = 0 operator is
-        not set up (an adaptive run's other step sizes: ``at(0)`` is then
-        the step matrix)."""
+    def build(cls, problem, k, initial=True):
+        """Factorise and condense the step matrices of ``problem`` for the
+        step k: A + w R(0), w the rule's weight of u_n (k, or k/2 for the
+        trapezoid, :func:`~.memory.step_tensor`); without ``initial`` the
+        t = 0 operator is not set up (a run's other step sizes:
+        ``at(True)`` is then the step matrix)."""
         t0 = time.perf_counter()
         assembly, free = problem.assembly, problem.free
         R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
@@ -163,7 +164,8 @@ class StepOperators:
 
         material = problem.options.material
         elastic = (material.lam, material.mu)
-        dlam, dmu = memory.instantaneous(problem.options.k if k is None else k)
+        options = problem.options
+        dlam, dmu = step_tensor(options.memory, options.second_order, k)
         stepped = (material.lam + dlam, material.mu + dmu)
         step = step_operator(*stepped)
         wanted, initial, shift, rho = initial, step, None, 0.0
@@ -194,26 +196,28 @@ class StepOperators:
             return self.step.unknowns, self.free.size
         return None
 
-    def at(self, n):
-        """The condensed step matrix of level n."""
-        return self.initial if n == 0 else self.step
+    def at(self, initial):
+        """The condensed step matrix of level 0 (``initial``: A, the t = 0
+        problem without memory) or of a step."""
+        return self.initial if initial else self.step
 
-    def tensor(self, n):
-        """(λ, μ) of the step matrix of level n."""
-        return self.tensors[0] if n == 0 else self.tensors[1]
+    def tensor(self, initial):
+        """(λ, μ) of the step matrix of level 0 (``initial``) or of a step."""
+        return self.tensors[0] if initial else self.tensors[1]
 
-    def lift(self, n, g):
-        """a_FD g_D: the force of the held values g (nD,) on the free dofs of level n."""
-        return self.support[0 if n == 0 else 1][0] @ g
+    def lift(self, initial, g):
+        """a_FD g_D: the force of the held values g (nD,) on the free dofs of
+        level 0 (``initial``) or of a step."""
+        return self.support[0 if initial else 1][0] @ g
 
-    def reaction(self, n, u_frame, f, contact=None):
-        """(a_n u)_D − f_D − F_D of level n on the held dofs, from the whole
-        nodal-frame ũ (ndofs,) (the rows of a_n R at the held dofs), the
+    def reaction(self, initial, u_frame, f, contact=None):
+        """(a_n u)_D − f_D − F_D of a level (``initial``: level 0) on the held
+        dofs, from the whole nodal-frame ũ (ndofs,) (the rows of a_n R at the held dofs), the
         load f_D on the held dofs (the memory history subtracted) and the
         contact laws' force F_D (nD,) along the held components of the
         contact nodes (None: none): the force the support alone exerts on
         the body, what a load cell in the grip reads."""
-        r = self.support[0 if n == 0 else 1][1] @ u_frame - f
+        r = self.support[0 if initial else 1][1] @ u_frame - f
         return r if contact is None else r - contact
 
     def held_frames(self, g):

@@ -20,6 +20,8 @@ class HistoryRecorder:
         nf = 0 if boundary is None else boundary.facets.size
         nprobes = 0 if problem.probe_map is None else problem.probe_map.shape[0]
         self.arrays = {
+            "t": np.zeros(levels),
+            "gap": np.zeros((levels, nc)) if problem.gap is not None else None,
             "u": np.zeros((levels, npoints, d)),
             "beta": np.zeros((levels, nf)),
             "stress": np.zeros((levels, ncells, d, d)),
@@ -49,5 +51,6 @@ class HistoryRecorder:
 
     def history(self):
         """The recorded levels n < count: field name -> array (count, ...),
-        None for a field the scene does not have (σ_zz in 3D)."""
+        None for a field the scene does not have (σ_zz in 3D, the gap
+        without a wall)."""
         return {name: None if a is None else a[:self.count] for name, a in self.arrays.items()}

@@ -62,6 +62,7 @@ class Solution:
     probes: np.ndarray            # (M+1, nprobes, d)
     iterations: np.ndarray        # (M+1,) Newton iterations per step
     residual: np.ndarray          # (M+1,) final relative projected residual
+    gap: np.ndarray = None        # (M+1, nc) g(x_a, t_n) of the wall, None without one
     reaction: np.ndarray = None   # (M+1, nD) force of the support per held dof
                                   # (problem.prescribed.fixed); see adhesive_contact.postprocess.reactions
     timings: dict = field(default_factory=dict)
@@ -132,8 +133,8 @@ class Solution:
     def gap_violation(self):
         """max_a (u_ν − g) per level over the contact nodes whose u_ν is not
         held (−inf without a wall or such nodes)."""
-        gap = self.problem.gap
+        gap = self.gap
         if gap is None or gap.shape[1] == 0:
             return np.full(self.t.size, -np.inf)
-        excess = self.normal_displacement - gap[:self.t.size]
+        excess = self.normal_displacement - gap
         return np.where(self.problem.boundary.held[:, 0], -np.inf, excess).max(axis=1)

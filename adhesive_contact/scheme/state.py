@@ -33,7 +33,8 @@ class State:
     memory: object       # the run's memory history (adhesive_contact.scheme.memory)
     z_before: np.ndarray = None   # the step's unknowns of level n − 1 (None before level 1)
     frame_u_before: np.ndarray = None   # frame_u of level n − 1 (None before level 1)
-    k_last: float = None   # t_n − t_{n−1} of an adaptive run (None: uniform steps k = T/N)
+    k_last: float = None   # t_n − t_{n−1}, the step that led here (None at level 0)
+    gap: np.ndarray = None   # (nc,) g(x_a, t_n) of the wall, None without one
 
 
 @dataclass
@@ -56,8 +57,48 @@ class Level:
                                   # held dof (the contact laws' is in contact_force)
     iterations: int
     residual: float
-    index: int = None             # its index in problem.times when that is not n (an
-                                  # adaptive run's levels lie on a finer grid)
+    gap: np.ndarray = None        # (nc,) g(x_a, t_n) of the wall, None without one
+    k: float = 0.0                # t_n − t_{n−1}, the step that led here (0 at level 0)
+
+
+@dataclass(frozen=True)
+class StepInput:
+    """What the step solve of one level is given: where it is (``index``
+    on the run's grid, for the notes; ``t``, the step ``k`` that leads
+    there, 0 at level 0, whose t = 0 problem has no memory), its load
+    ``b`` on the free dofs in frames and :class:`KnownPart`, β_n, the gap
+    of the level and of the level before, and the starts ``z0`` (level
+    n − 1's unknowns) and ``z_before`` (level n − 2's, for the predictor;
+    None)."""
+
+    index: int
+    t: float
+    k: float
+    b: np.ndarray
+    known: object
+    beta: np.ndarray
+    gap: np.ndarray
+    gap_before: np.ndarray
+    z0: np.ndarray
+    z_before: np.ndarray = None
+
+    @property
+    def initial(self):
+        """Whether this is level 0, the t = 0 problem without memory."""
+        return self.k == 0.0
+
+
+@dataclass
+class StepOutcome:
+    """What a step solve returns: the ``level`` (None when the solve
+    failed), u_n, its nodal-frame components at the contact nodes, the
+    step unknowns z and the step method's ``result`` (None without Γ_C)."""
+
+    level: Level
+    u: np.ndarray
+    frame_u: np.ndarray
+    z: np.ndarray
+    result: object
 
 
 NEWTON = ("newton", "newton-plain")   # the methods that converge quadratically
@@ -124,13 +165,15 @@ class ContactStep:
         if self.kink is not None and np.any(self.kink.tangential < 0):
             self.kink.offset = values.reshape(boundary.held.shape)[self.kink_nodes, 1:]
 
-    def minimise(self, S, c, beta, n, z0, tighter=1.0, before=None, iterations=None):
+    def minimise(self, S, c, beta, step, z0, tighter=1.0, before=None, iterations=None):
         """The step solve of (4.1) on the contact unknowns with β_n, by
-        ``solver.method``; a Newton method's tolerance times ``tighter``
-        and, with ``iterations``, its iterations at most that many.
-        ``z0`` is the last level's solution; with ``before``, the one of
-        the level before it, the "newton" method starts from the
-        :meth:`predictor` where that lowers the step energy."""
+        ``solver.method``, for the :class:`StepInput` ``step`` (its gap,
+        the gap before it and its index for the notes); a Newton method's
+        tolerance times ``tighter`` and, with ``iterations``, its
+        iterations at most that many. ``z0`` is the last level's solution;
+        with ``before``, the one of the level before it, the "newton"
+        method starts from the :meth:`predictor` where that lowers the
+        step energy."""
         problem = self.problem
         self.energy.set_bonding(beta)
         self.energy.set_pressure(z0)   # a Coulomb bound: at the last level's pressure first
@@ -142,10 +185,11 @@ class ContactStep:
             if iterations is not None:
                 options = replace(options, max_iter=min(options.max_iter, iterations))
         upper = np.full(self.size, np.inf)
-        upper[self.unknowns] = problem.upper_bound(n)
+        upper[self.unknowns] = problem.upper_bound(step.gap)
+        n = step.index
         start = time.perf_counter()
         if before is not None and solver.method == "newton":
-            z0 = self.predictor(S, c, upper, z0, before, n)
+            z0 = self.predictor(S, c, upper, z0, before, step.gap_before)
         S.indefinite, solves_before = False, S.indefinite_solves
         if (self.energy.pressure_dependent and self.problem.held_by_contact
                 and not np.any(self.kink.radius > 0)):
@@ -237,7 +281,7 @@ class ContactStep:
         result.nit = nit
         return result
 
-    def predictor(self, S, c, upper, last, before, n):
+    def predictor(self, S, c, upper, last, before, gap_before):
         """The start of step n from the last two levels: z_{n−1} + (z_{n−1}
         − z_{n−2}) (uniform steps), with the sets of level n − 1 kept
         (a node stuck there, ξ = 0, stays stuck; one on the wall of t_{n−1}
@@ -245,10 +289,10 @@ class ContactStep:
         itself where the extrapolation does not lower the step energy
         ½ zᵀ S z − cᵀ z + Φ(z) (β_n, the load of level n). Then the stick
         front is moved on as far as it moved in the last step
-        (:meth:`front_moved_on`)."""
+        (:meth:`front_moved_on`). ``gap_before``: the gap of level n − 1."""
         guess = 2.0 * last - before
         positions = self.unknowns
-        wall_before = self.problem.upper_bound(n - 1)
+        wall_before = self.problem.upper_bound(gap_before)
         held = np.isfinite(wall_before) & (last[positions] >= wall_before)
         guess[positions[held]] = upper[positions[held]]
         if self.kink is not None:
@@ -327,43 +371,38 @@ class ContactStep:
                            solver.smoothing * diameter)
 
 
-def initial_state(problem, memory, unknowns=None):
-    """Level "−1": β_0^h = P_B β_0, zero displacement, an empty history;
-    ``unknowns`` the size of the step unknowns (default: the contact
-    unknowns)."""
+def initial_state(problem, unknowns=None):
+    """Level "−1": β_0^h = P_B β_0, zero displacement, no history yet (the
+    memory starts from u_0, :func:`~.memory.start_memory`); ``unknowns``
+    the size of the step unknowns (default: the contact unknowns)."""
     nc = 0 if problem.boundary is None else problem.boundary.nodes.size
-    memory.begin(problem.options.k, problem.ndofs)
     size = problem.columns.size if unknowns is None else unknowns
-    return State(n=-1, t=-problem.options.k, beta=problem.beta0.copy(),
-                 z=np.zeros(size), u=np.zeros(problem.ndofs),
-                 frame_u=np.zeros(nc * problem.dim), memory=memory)
+    return State(n=-1, t=0.0, beta=problem.beta0.copy(), z=np.zeros(size),
+                 u=np.zeros(problem.ndofs), frame_u=np.zeros(nc * problem.dim), memory=None)
 
 
-def bonding_step(problem, state, k=None):
-    """(4.2): β_n from β_{n−1} and u_{n−1} by the scene's integrator
-    (:mod:`adhesive_contact.scheme.bonding`); explicit Euler, the paper's, is
-    β_n = β_{n−1} + k P_B F(u_{n−1,ν}, u_{n−1,τ}, β_{n−1}) (β frozen
-    without a bonding law, and at n = 0); a rate-independent law's damage
-    update (:mod:`adhesive_contact.scheme.bonding.damage`) in its place.
+def bonding_step(problem, state, k):
+    """(4.2): β_n from β_{n−1} and u_{n−1} over the step k = t_n − t_{n−1}
+    by the scene's integrator (:mod:`adhesive_contact.scheme.bonding`);
+    explicit Euler, the paper's, is β_n = β_{n−1} + k P_B F(u_{n−1,ν},
+    u_{n−1,τ}, β_{n−1}) (β frozen without a bonding law, and at n = 0); a
+    rate-independent law's damage update
+    (:mod:`adhesive_contact.scheme.bonding.damage`) in its place.
 
     The second-order scheme freezes the rate at the midpoint t_{n−½}: the
-    displacement extrapolated there, u_{n−½} ≈ (3 u_{n−1} − u_{n−2})/2
-    (u_0 itself for n = 1: one step's O(k²) error), the source s_β(t_{n−½});
-    its integrator (exponential midpoint) is second order in that rate.
-
-    ``k`` is the step of an adaptive run (default k = T/N); on its
-    nonuniform grid the extrapolation is u_{n−1} + (k/(2 k_{n−1}))
-    (u_{n−1} − u_{n−2})."""
+    displacement extrapolated there, u_{n−½} ≈ (3 u_{n−1} − u_{n−2})/2 on
+    equal steps, u_{n−1} + (k/(2 k_{n−1})) (u_{n−1} − u_{n−2}) on unequal
+    ones (u_0 itself for n = 1: one step's O(k²) error), the source
+    s_β(t_{n−½}); its integrator (exponential midpoint) is second order in
+    that rate."""
     if problem.bonding is None or state.n < 0:
         return state.beta
     boundary = problem.boundary
     frame_u, t = state.frame_u, state.t
-    uniform = k is None
-    k = problem.options.k if uniform else k
     if problem.options.second_order:
         t = state.t + 0.5 * k
         if state.frame_u_before is not None:
-            if uniform:
+            if state.k_last == k:
                 frame_u = 1.5 * state.frame_u - 0.5 * state.frame_u_before
             else:
                 frame_u = state.frame_u + (0.5 * k / state.k_last) * (
@@ -392,17 +431,13 @@ class KnownPart:
     held_load: np.ndarray
 
 
-def step_load(problem, operators, state, n, t):
-    """The load of level n on the free dofs in nodal frames: f(t_n) minus
-    the force of the memory history k Σ_{j<n} R(t_n − t_j) ε(u_j) (u_j the
-    whole displacement, held part included), minus the force a_FD g_D(t_n)
-    of the held values; and the :class:`KnownPart` of the level."""
-    return history_load(problem, operators, n, t,
-                        state.memory.history(n) if n >= 1 else None)
-
-
-def history_load(problem, operators, n, t, history):
-    """:func:`step_load` with the memory history's (a_λ, a_μ) given (None: zero)."""
+def history_load(problem, operators, initial, t, history):
+    """The load of a level on the free dofs in nodal frames: f(t_n) minus
+    the force of the memory history (its (a_λ, a_μ), None: zero; the
+    rule's Σ_{j<n} w_j R(t_n − t_j) ε(u_j), u_j the whole displacement,
+    held part included), minus the force a_FD g_D(t_n) of the held values
+    (``initial``: level 0's step matrix); and the :class:`KnownPart` of
+    the level."""
     f = problem.loads(t)
     if history is not None:
         f -= problem.assembly.force(*history)
@@ -410,98 +445,107 @@ def history_load(problem, operators, n, t, history):
     g = held.values(t)
     b = operators.to_frames(f)
     if not held.is_zero:
-        b -= operators.lift(n, g)
+        b -= operators.lift(initial, g)
     return b, KnownPart(history, g, f[held.fixed])
 
 
-def step_solve(problem, operators, contact, n, t, b, beta, known, z0, z_before=None):
-    """(4.1) at level n: the nonsmooth problem on the contact unknowns, then
-    the interior by back substitution, the held values g_D(t_n) put in, the
-    stress σ_n = C ε(u_n) + k R(0) ε(u_n) + history, the contact reactions
-    and the reactions of the held dofs.
+def step_solve(problem, operators, contact, step):
+    """(4.1) at one level (:class:`StepInput` ``step``): the nonsmooth
+    problem on the contact unknowns, then the interior by back
+    substitution, the held values g_D(t_n) put in, the stress σ_n = C ε(u_n)
+    + k R(0) ε(u_n) + history, the contact reactions and the reactions of
+    the held dofs; a :class:`StepOutcome`.
 
     The force of Γ_C at a free component of a contact node is its reaction
     in the frame equations (S z − c). At a held component the contact laws
     act too (at the prescribed value), F_D = −∂Φ/∂z_D: ``contact_force``
     holds it there, and the support's force is what is left of the held
-    rows, R = (a_n u)_D − f_D − F_D, so that Σ_sides R + Σ_a R_a F_a + ∫ f = 0.
-
-    ``z0`` the step unknowns of level n − 1, ``z_before`` those of level
-    n − 2 (for the predictor of :meth:`ContactStep.predictor`), or None.
-
-    Returns ``(level, u, frame_u, z, result)``; ``result`` is the
-    :class:`~adhesive_contact.step_methods.StepResult` (None without Γ_C)."""
-    history = known.history
-    step = operators.at(n)
-    d = problem.dim
-    nc = 0 if problem.boundary is None else problem.boundary.nodes.size
-    force = np.zeros((nc, d))
-    on_wall = np.zeros(nc, dtype=bool)
-    stuck = np.zeros(nc, dtype=bool)
+    rows, R = (a_n u)_D − f_D − F_D, so that Σ_sides R + Σ_a R_a F_a + ∫ f = 0."""
+    known, initial = step.known, step.initial
+    operator = operators.at(initial)
     if contact is not None:
         contact.hold(known.prescribed)
-    if n == 0 and operators.shift is not None:
-        u_free, z, c, result = proximal_solve(step, operators.shift, contact, n, b, beta, z0,
+    if initial and operators.shift is not None:
+        u_free, z, c, result = proximal_solve(operator, operators.shift, contact, step,
                                               operators.contraction)
     else:
-        u_free, z, c, result = free_solve(step, contact, n, b, beta, z0, before=z_before)
+        u_free, z, c, result = free_solve(operator, contact, step, step.b, step.z0,
+                                          before=step.z_before)
     if u_free is None:
-        return None, None, None, z0, result
-    held_force = None
-    if contact is not None:
-        # the force of Γ_C on the body: its reaction in the frame equations at
-        # the free components, −∂Φ/∂z_D of the laws at the held ones
-        force.reshape(-1)[problem.columns] = (step.S @ z - c)[contact.unknowns]
-        if contact.energy.held.size:
-            force.reshape(-1)[contact.energy.held] = -contact.energy.held_gradient(z)
-            held_force = problem.boundary.held_forces(force.reshape(-1),
-                                                      problem.prescribed.fixed.size)
-        normal = problem.normal_columns
-        on_wall[problem.columns[normal] // d] = result.on_wall[contact.unknowns][normal]
-        if contact.kink is not None and problem.friction.has_kink:
-            stuck[contact.kink_nodes] = result.stuck
+        return StepOutcome(None, None, None, step.z0, result)
+    d = problem.dim
+    nc = 0 if problem.boundary is None else problem.boundary.nodes.size
+    force, on_wall, stuck, held_force = contact_results(problem, operator, contact, z, c,
+                                                        result, nc)
     u_frame = np.zeros(problem.ndofs)
     u_frame[operators.free] = u_free
     u_frame[problem.prescribed.fixed] = operators.held_frames(known.prescribed)
     u = operators.from_frames(u_frame)
     frame_u = problem.boundary.frame_components(u) if nc else np.zeros(0)
-
-    lam, mu = operators.tensor(n)
+    lam, mu = operators.tensor(initial)
     a_lam, a_mu = lam * u, mu * u
-    if history is not None:
-        a_lam, a_mu = a_lam + history[0], a_mu + history[1]
+    if known.history is not None:
+        a_lam, a_mu = a_lam + known.history[0], a_mu + known.history[1]
     stress, zz = problem.assembly.cell_stress(a_lam, a_mu)
     points = u.reshape(-1, d)
     level = Level(
-        n=n, t=t, u=points, beta=beta, stress=stress, stress_zz=zz if d == 2 else None,
-        contact_force=force, frame_displacement=frame_u.reshape(nc, d), on_wall=on_wall,
-        stuck=stuck, probes=(problem.probe_map @ points if problem.probe_map is not None
-                             else np.zeros((0, d))),
-        reaction=operators.reaction(n, u_frame, known.held_load, held_force),
+        n=step.index, t=step.t, u=points, beta=step.beta, stress=stress,
+        stress_zz=zz if d == 2 else None, contact_force=force,
+        frame_displacement=frame_u.reshape(nc, d), on_wall=on_wall, stuck=stuck,
+        probes=(problem.probe_map @ points if problem.probe_map is not None
+                else np.zeros((0, d))),
+        reaction=operators.reaction(initial, u_frame, known.held_load, held_force),
         iterations=0 if result is None else result.nit,
-        residual=0.0 if result is None else result.residual)
-    return level, u, frame_u, z, result
+        residual=0.0 if result is None else result.residual, gap=step.gap, k=step.k)
+    return StepOutcome(level, u, frame_u, z, result)
 
 
-def free_solve(step, contact, n, b, beta, z0, tighter=1.0, before=None, iterations=None):
-    """The free dofs of (4.1) with the condensed step matrix ``step`` and
-    the load b: the contact problem on z, then the interior by back
+def contact_results(problem, operator, contact, z, c, result, nc):
+    """(force (nc, d), on_wall (nc,), stuck (nc,), held_force (nD,) or
+    None) of a solved step: the force of Γ_C on the body, its reaction in
+    the frame equations at the free components, −∂Φ/∂z_D of the laws at
+    the held ones (also as the held dofs' share, for the reactions), and
+    the wall and stick sets."""
+    d = problem.dim
+    force = np.zeros((nc, d))
+    on_wall = np.zeros(nc, dtype=bool)
+    stuck = np.zeros(nc, dtype=bool)
+    held_force = None
+    if contact is None:
+        return force, on_wall, stuck, held_force
+    force.reshape(-1)[problem.columns] = (operator.S @ z - c)[contact.unknowns]
+    if contact.energy.held.size:
+        force.reshape(-1)[contact.energy.held] = -contact.energy.held_gradient(z)
+        held_force = problem.boundary.held_forces(force.reshape(-1),
+                                                  problem.prescribed.fixed.size)
+    normal = problem.normal_columns
+    on_wall[problem.columns[normal] // d] = result.on_wall[contact.unknowns][normal]
+    if contact.kink is not None and problem.friction.has_kink:
+        stuck[contact.kink_nodes] = result.stuck
+    return force, on_wall, stuck, held_force
+
+
+def free_solve(operator, contact, step, b, z0, tighter=1.0, before=None, iterations=None):
+    """The free dofs of (4.1) with the condensed step matrix ``operator``
+    and the load b (β_n and the gaps of the :class:`StepInput` ``step``):
+    the contact problem on z from ``z0``, then the interior by back
     substitution. Returns ``(u_free, z, c, result)``, u_free None when the
     contact solve failed; ``result`` None without Γ_C. With ``iterations``
     the contact solve takes at most that many Newton iterations, and an
     iterate it leaves unconverged (MAX_ITERATIONS) is expanded as well."""
-    c = step.reduce(b)
+    c = operator.reduce(b)
     result, z = None, z0
     if contact is not None:
-        result = contact.minimise(step.S, c, beta, n, z0, tighter, before, iterations)
+        result = contact.minimise(operator.S, c, step.beta, step, z0, tighter, before,
+                                  iterations)
         partial = iterations is not None and result.status == MAX_ITERATIONS
         if not (result.success or partial):
             return None, z0, c, result
         z = result.z
-    return step.expand(z, b), z, c, result
+    return operator.expand(z, b), z, c, result
 
 
-def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13):
+def proximal_solve(operator, shift, contact, step, contraction, rtol=1e-13):
     """The t = 0 problem min ½ uᵀ A u − bᵀ u + Φ(u_C) on the free dofs with the
     factorisation of a_n = A + D only (:mod:`adhesive_contact.scheme.operators`):
     u⁽ⁱ⁺¹⁾ solves the step with the load b + D u⁽ⁱ⁾, from u⁽⁰⁾ = 0, until
@@ -518,13 +562,14 @@ def proximal_solve(step, shift, contact, n, b, beta, z0, contraction, rtol=1e-13
     iterations of all of them; its load c is that of the last, so that
     S z − c is the contact force of the t = 0 problem (a_n u − D u = A u).
     Same returns as :func:`free_solve`."""
+    b, z0 = step.b, step.z0
     u = np.zeros(b.size)
     # ρ^i below rtol, with a margin for the contact terms' nonlinearity
     limit = 10 + int(np.log(rtol) / np.log(max(contraction, 1e-3)))
     budget = 0 if contact is None else int(contact.problem.options.solver.max_iter)
     total = settled = unsettled = 0
     while settled < limit:
-        u_next, z0, c, result = free_solve(step, contact, n, b + shift @ u, beta, z0,
+        u_next, z0, c, result = free_solve(operator, contact, step, b + shift @ u, z0,
                                            tighter=1e-2, iterations=1)
         converged = result is None or result.success
         if result is not None:

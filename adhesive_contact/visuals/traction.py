@@ -59,7 +59,7 @@ def figure_contact_traction(solution):
     states = contact_states(solution)
     kinked = problem.friction is not None and problem.friction.has_kink
     stuck = states["stick"][:, order] if "stick" in states else np.zeros_like(wall)
-    gap = None if problem.gap is None else problem.gap[:, order]
+    gap = None if solution.gap is None else solution.gap[:, order]
     style = "-" if problem.dim == 2 else "none"  # 3D: scattered nodes, no lines
 
     levels = plot_levels(solution)

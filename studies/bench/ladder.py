@@ -114,7 +114,6 @@ def run_case(doc):
     """One case, in this process: the record of the module docstring."""
     from adhesive_contact import build_problem, scene_from_dict, solve
     from adhesive_contact.resources import estimate
-    from adhesive_contact.scheme.memory import start_memory
     from adhesive_contact.scheme.operators import StepOperators
 
     scene = scene_from_dict(doc)
@@ -127,8 +126,7 @@ def run_case(doc):
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     timings = solution.timings
     # the linear work of one step, with the run's backend
-    memory = start_memory(problem)
-    operators = StepOperators.build(problem, memory)
+    operators = StepOperators.build(problem, problem.options.k)
     step = operators.step
     b = np.random.default_rng(0).standard_normal(problem.free.size)
     pairs = []

@@ -36,7 +36,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from adhesive_contact import build_problem, scene_from_dict  # noqa: E402
-from adhesive_contact.scheme.memory import start_memory  # noqa: E402
 from adhesive_contact.scheme.operators import StepOperators  # noqa: E402
 from adhesive_contact.scheme.state import ContactStep  # noqa: E402
 from adhesive_contact.step_methods import StepOptions, minimise  # noqa: E402
@@ -208,14 +207,14 @@ def starting_points(spread, tries=6, seed=0):
             doc["contact"]["friction"][0]["alpha"] = alpha
             doc["contact"]["normal"]["c"] = c
             problem = build_problem(scene_from_dict(doc))
-            ops = StepOperators.build(problem, start_memory(problem))
-            step = ops.at(1)
-            rhs = step.reduce(ops.to_frames(problem.loads(problem.times[1])))
+            ops = StepOperators.build(problem, problem.options.k)
+            step = ops.at(False)
+            rhs = step.reduce(ops.to_frames(problem.loads(problem.options.k)))
             contact = ContactStep(problem)
             contact.energy.set_bonding(problem.beta0)
             contact.kink.radius = contact.energy.node_kink(problem.boundary.point_node,
                                                            problem.boundary.nodes.size)
-            upper = problem.upper_bound(1)
+            upper = problem.upper_bound(None if problem.gap is None else problem.gap.at(problem.options.k))
             options = StepOptions(1e-10, 200)
             first = minimise("newton", step.S, rhs, contact.energy, upper,
                              np.zeros(rhs.size), options, contact.kink)

@@ -99,8 +99,8 @@ def half_width(problem, solution, nodes=3):
     x = problem.mesh.p[0, problem.boundary.nodes]
     order = np.argsort(x)
     x = x[order]
-    opening = (problem.gap[0][None, :] - solution.frame_displacement[:, :, 0])[:, order]
-    closed_below = 1e-9 * problem.gap[0].max()
+    opening = (solution.gap[0][None, :] - solution.frame_displacement[:, :, 0])[:, order]
+    closed_below = 1e-9 * solution.gap[0].max()
     a = np.empty(solution.t.size)
     for n, d in enumerate(opening):
         last = int(np.flatnonzero(d <= closed_below).max())
