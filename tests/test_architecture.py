@@ -119,3 +119,18 @@ def test_every_test_file_is_in_the_verification_map():
     listed = set(re.findall(r"^\| `(test_\w+\.py)` \|", table, re.M))
     present = {path.name for path in (ROOT / "tests").glob("test_*.py")}
     assert listed == present
+
+
+def test_no_function_over_80_lines_in_the_scheme_core():
+    """The time scheme's core stays readable (issue: "no function over 80
+    lines in scheme/ and step_methods/")."""
+    long = []
+    for folder in ("scheme", "step_methods"):
+        for path in sorted((PACKAGE / folder).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    lines = node.end_lineno - node.lineno + 1
+                    if lines > 80:
+                        long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} "
+                                    f"({lines} lines)")
+    assert not long, long

@@ -89,103 +89,20 @@ class StepOperators:
         t = 0 operator is not set up (a run's other step sizes:
         ``at(True)`` is then the step matrix)."""
         t0 = time.perf_counter()
-        assembly, free = problem.assembly, problem.free
-        R = problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None else None
-        contact = problem.contact_positions
-        method, reason = problem.options.solver.linear, "method {!r} was asked for."
-        if method == "auto":   # nnz of the free block, pro rata of the free dofs
-            nnz = int(assembly.K_mu.nnz * free.size / max(assembly.ndofs, 1))
-            method, reason = choose(free.size, nnz, problem.dim,
-                                    contact_unknowns=_newton_unknowns(problem))
-        else:
-            reason = reason.format(method)
-
-        def factorise(A_II, interior):
-            # the rigid body modes of AMG in Cartesian components (the few
-            # rotated dofs at Γ_C only weaken its near-nullspace there)
-            solver = make_linear_solver(A_II, method, dim=problem.dim, points=problem.mesh.p,
-                                        dofs=free[interior],
-                                        tol=problem.options.solver.linear_tol)
-            solver.reason = reason
-            return solver
-
-        fixed = problem.prescribed.fixed
-        # ũ_D = s g_D: R is ±1 on its diagonal at the held dofs (a held
-        # component of a contact node is ±u_h there, ContactBoundary.rotation)
-        sign = R.diagonal()[fixed] if R is not None else np.ones(fixed.size)
-        support = {}   # (λ, μ) -> (a_FD, a_D·): the coupling and the held rows
-
-        def frames(lam, mu):
-            A = assembly.stiffness(lam, mu)
-            return (R.T @ A @ R).tocsr() if R is not None else A
-
-        def coupled(lam, mu):
-            """The matrix of (λ, μ) in frames, its coupling and held rows kept."""
-            A = frames(lam, mu)
-            # s·(rows of Rᵀ a R at the held dofs) = rows of a R: (a u)_D from ũ, and
-            # a_FD s g_D = (those rows)_F ᵀ g_D, the force of the held values
-            rows = A[fixed]
-            if np.any(sign != 1.0):
-                rows = (sp.diags(sign) @ rows).tocsr()
-            support[(lam, mu)] = (rows[:, free].T.tocsr(), rows)
-            return A
-
-        # with AMG the step method iterates on all free dofs (a Schur complement
-        # would cost one CG solve per contact unknown), if it can (FULL_SYSTEM)
-        unreduced = (method == "amg" and contact.size > 0
-                     and problem.options.solver.method in FULL_SYSTEM)
-
-        def step_operator(lam, mu, nearby=None):
-            """The operator of (λ, μ) on the free dofs; ``nearby`` is what the
-            step matrix lends it to precondition with (its Schur complement, or
-            with AMG its hierarchy), or None to set up its own."""
-            A = coupled(lam, mu)[free][:, free]
-            if unreduced:
-                return FullSystemOperator(A, contact, factorise=factorise, solver=nearby)
-            # a body held by contact: S is singular along the free rigid motions,
-            # and a partial factorisation (PARDISO's) stops at its zero pivot.
-            # δ I on the contact block changes S by exactly δ I and nothing else
-            # (a_II, and so reduce and expand, do not see it): factorise A + δ I_C
-            # and take δ I back off S (docs/scheme.md, 'A body held by contact')
-            delta = (float(A.diagonal()[contact].max())
-                     if problem.held_by_contact and contact.size else 0.0)
-            if delta:
-                A = (A + sp.coo_matrix((np.full(contact.size, delta), (contact, contact)),
-                                       shape=A.shape)).tocsr()
-            if method == "pardiso" and contact.size:   # S and the solve halves in one
-                operator = PartialCondensation(A, contact)
-                operator.solver.reason = reason
-            else:
-                operator = CondensedOperator(A, contact, factorise=factorise,
-                                             approximation=nearby)
-            if delta:
-                unshift(operator, delta)
-            return operator
-
-        material = problem.options.material
-        elastic = (material.lam, material.mu)
+        factory = OperatorFactory(problem)
         options = problem.options
+        material = options.material
+        elastic = (material.lam, material.mu)
         dlam, dmu = step_tensor(options.memory, options.second_order, k)
         stepped = (material.lam + dlam, material.mu + dmu)
-        step = step_operator(*stepped)
-        wanted, initial, shift, rho = initial, step, None, 0.0
-        if not wanted:
-            coupled(*elastic)
-        elif (dlam, dmu) != (0.0, 0.0):
-            rho = contraction(elastic, (dlam, dmu), problem.dim)
-            if unreduced:   # A at t = 0, preconditioned by a_n's hierarchy
-                initial = step_operator(*elastic, nearby=step.solver)
-            elif rho <= PROXIMAL_UP_TO:   # t = 0 by the proximal iteration on a_n's factors
-                coupled(*elastic)
-                shift = frames(dlam, dmu)[free][:, free]
-            else:   # with PARDISO the t = 0 operator forms S as cheaply as it applies it
-                nearby = None if isinstance(step, PartialCondensation) else step.S.matrix
-                initial = step_operator(*elastic, nearby=nearby)
-        schur = initial.schur_seconds + (step.schur_seconds if step is not initial else 0.0)
-        return cls(rotation=R, free=free, initial=initial, step=step,
-                   tensors=(elastic, stepped), support=(support[elastic], support[stepped]),
-                   held_sign=sign, factor_seconds=time.perf_counter() - t0, schur_seconds=schur,
-                   shift=shift, contraction=rho)
+        step = factory.operator(*stepped)
+        start, shift, rho = initial_operator(factory, step, elastic, (dlam, dmu), initial)
+        schur = start.schur_seconds + (step.schur_seconds if step is not start else 0.0)
+        return cls(rotation=factory.R, free=factory.free, initial=start, step=step,
+                   tensors=(elastic, stepped),
+                   support=(factory.support[elastic], factory.support[stepped]),
+                   held_sign=factory.sign, factor_seconds=time.perf_counter() - t0,
+                   schur_seconds=schur, shift=shift, contraction=rho)
 
     @property
     def within(self):
@@ -233,6 +150,123 @@ class StepOperators:
     def from_frames(self, u_frame):
         """Cartesian components u = R ũ of a nodal-frame vector (ndofs,)."""
         return self.rotation @ u_frame if self.rotation is not None else u_frame
+
+
+def backend_of(problem):
+    """(method, reason): the linear backend of ``problem``'s ``solver.linear``,
+    ``"auto"`` resolved by :func:`~adhesive_contact.linear_solvers.choose`."""
+    assembly, free = problem.assembly, problem.free
+    method = problem.options.solver.linear
+    if method != "auto":
+        return method, f"method {method!r} was asked for."
+    nnz = int(assembly.K_mu.nnz * free.size / max(assembly.ndofs, 1))   # pro rata
+    return choose(free.size, nnz, problem.dim, contact_unknowns=_newton_unknowns(problem))
+
+
+class OperatorFactory:
+    """Builds the step operators of one problem (a step matrix of a tensor
+    (λ, μ) in the nodal frames, on the free dofs, condensed onto the
+    contact unknowns or, with AMG, on all free dofs) and keeps the coupling
+    of each tensor to the held dofs (``support``: (λ, μ) -> (a_FD, a_D·))."""
+
+    def __init__(self, problem):
+        self.problem = problem
+        assembly, self.free = problem.assembly, problem.free
+        self.R = (problem.boundary.rotation(assembly.ndofs) if problem.boundary is not None
+                  else None)
+        self.contact = problem.contact_positions
+        self.method, self.reason = backend_of(problem)
+        self.fixed = problem.prescribed.fixed
+        # ũ_D = s g_D: R is ±1 on its diagonal at the held dofs (a held
+        # component of a contact node is ±u_h there, ContactBoundary.rotation)
+        self.sign = (self.R.diagonal()[self.fixed] if self.R is not None
+                     else np.ones(self.fixed.size))
+        self.support = {}
+        # with AMG the step method iterates on all free dofs (a Schur complement
+        # would cost one CG solve per contact unknown), if it can (FULL_SYSTEM)
+        self.unreduced = (self.method == "amg" and self.contact.size > 0
+                          and problem.options.solver.method in FULL_SYSTEM)
+
+    def factorise(self, A_II, interior):
+        """The linear solver of A_II (the rigid body modes of AMG in Cartesian
+        components: the few rotated dofs at Γ_C only weaken its
+        near-nullspace there)."""
+        problem = self.problem
+        solver = make_linear_solver(A_II, self.method, dim=problem.dim, points=problem.mesh.p,
+                                    dofs=self.free[interior],
+                                    tol=problem.options.solver.linear_tol)
+        solver.reason = self.reason
+        return solver
+
+    def frames(self, lam, mu):
+        """The stiffness of (λ, μ) in the nodal frames, Rᵀ A R."""
+        A = self.problem.assembly.stiffness(lam, mu)
+        return (self.R.T @ A @ self.R).tocsr() if self.R is not None else A
+
+    def coupled(self, lam, mu):
+        """The matrix of (λ, μ) in frames, its coupling and held rows kept:
+        s·(rows of Rᵀ a R at the held dofs) = rows of a R, (a u)_D from ũ,
+        and a_FD s g_D = (those rows)_F ᵀ g_D, the force of the held values."""
+        A = self.frames(lam, mu)
+        rows = A[self.fixed]
+        if np.any(self.sign != 1.0):
+            rows = (sp.diags(self.sign) @ rows).tocsr()
+        self.support[(lam, mu)] = (rows[:, self.free].T.tocsr(), rows)
+        return A
+
+    def operator(self, lam, mu, nearby=None):
+        """The operator of (λ, μ) on the free dofs; ``nearby`` is what the
+        step matrix lends it to precondition with (its Schur complement, or
+        with AMG its hierarchy), or None to set up its own."""
+        problem, contact, free = self.problem, self.contact, self.free
+        A = self.coupled(lam, mu)[free][:, free]
+        if self.unreduced:
+            return FullSystemOperator(A, contact, factorise=self.factorise, solver=nearby)
+        # a body held by contact: S is singular along the free rigid motions,
+        # and a partial factorisation (PARDISO's) stops at its zero pivot.
+        # δ I on the contact block changes S by exactly δ I and nothing else
+        # (a_II, and so reduce and expand, do not see it): factorise A + δ I_C
+        # and take δ I back off S (docs/scheme.md, 'A body held by contact')
+        delta = (float(A.diagonal()[contact].max())
+                 if problem.held_by_contact and contact.size else 0.0)
+        if delta:
+            A = (A + sp.coo_matrix((np.full(contact.size, delta), (contact, contact)),
+                                   shape=A.shape)).tocsr()
+        if self.method == "pardiso" and contact.size:   # S and the solve halves in one
+            operator = PartialCondensation(A, contact)
+            operator.solver.reason = self.reason
+        else:
+            operator = CondensedOperator(A, contact, factorise=self.factorise,
+                                         approximation=nearby)
+        if delta:
+            unshift(operator, delta)
+        return operator
+
+
+def initial_operator(factory, step, elastic, shift, wanted=True):
+    """How level 0 (A alone, no memory yet) is solved, given the step
+    operator ``step`` of A + D (D the tensor ``shift`` of w R(0)):
+    (operator, proximal shift D or None, its contraction bound ρ).
+
+    Without memory, or when not ``wanted`` (a run's other step sizes), the
+    step operator itself; with AMG, A's own operator preconditioned by the
+    step's hierarchy; for ρ ≤ PROXIMAL_UP_TO the proximal iteration on the
+    step's factors (module docstring); else A's own operator, with the
+    step's Schur complement lent to precondition it."""
+    if not wanted:
+        factory.coupled(*elastic)
+        return step, None, 0.0
+    if tuple(shift) == (0.0, 0.0):
+        return step, None, 0.0
+    rho = contraction(elastic, shift, factory.problem.dim)
+    if factory.unreduced:   # A at t = 0, preconditioned by a_n's hierarchy
+        return factory.operator(*elastic, nearby=step.solver), None, rho
+    if rho <= PROXIMAL_UP_TO:   # t = 0 by the proximal iteration on a_n's factors
+        factory.coupled(*elastic)
+        return step, factory.frames(*shift)[factory.free][:, factory.free], rho
+    # with PARDISO the t = 0 operator forms S as cheaply as it applies it
+    nearby = None if isinstance(step, PartialCondensation) else step.S.matrix
+    return factory.operator(*elastic, nearby=nearby), None, rho
 
 
 def unshift(operator, delta):

@@ -75,7 +75,7 @@ from .base import (
     stationarity,
 )
 
-__all__ = ["minimise", "minimise_step", "StepResult", "Kink", "CONVERGED",
+__all__ = ["minimise", "minimise_step", "ProjectedNewton", "StepResult", "Kink", "CONVERGED",
            "MAX_ITERATIONS", "LINE_SEARCH_FAILED", "DIVERGED"]
 
 
@@ -86,7 +86,8 @@ def minimise(S, c, energy, upper, z0, options, kink=None):
 
 def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, sigma=1e-4,
                   globalised=True, semismooth=None):
-    """Minimise ½ zᵀSz − cᵀz + Φ(z) subject to z ≤ upper (see module doc).
+    """Minimise ½ zᵀSz − cᵀz + Φ(z) subject to z ≤ upper (see module doc):
+    :meth:`ProjectedNewton.minimise` from ``z0``.
 
     Parameters
     ----------
@@ -108,123 +109,203 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
     semismooth : try the semismooth Newton step of :func:`semismooth_step`
         first at every iteration (default: when ``globalised``)
     """
-    if semismooth is None:
-        semismooth = globalised
-    nz = c.size
-    bounded = np.isfinite(upper)
-    if kink is None:
-        kink = no_kink()
-    tan, kappa = kink.tangential, kink.radius
+    return ProjectedNewton(S, c, energy, upper, tol, max_iter, kink, sigma, globalised,
+                           semismooth).minimise(z0)
 
-    # E at a trial point as E(z) plus its change from the iterate z,
-    # (Sz − c)·Δ + ½ Δ·SΔ + Φ(z + Δ) − Φ(z): ½ zᵀSz − cᵀz itself is a
-    # difference of large terms when the body has moved far (|S||z|² ≫ |E|),
-    # whose round-off would hide the decrease of a last Newton step
-    here = {}
 
-    def anchor(z, E, Sz):
-        here.update(z=z, E=E, g=Sz - c, phi=energy.value(z))
+class ProjectedNewton:
+    """One step solve by the Newton strategies of the module docstring,
+    each a method: :meth:`chord` (a chord step on the last Newton matrix),
+    :meth:`semismooth` (the semismooth step on the projection form, its
+    sets free), :meth:`held_direction` (sets and slip directions held for
+    the step, with an Armijo line search or, unglobalised, the full step);
+    :meth:`minimise` tries them in that order each iteration."""
 
-    def total(trial):
+    def __init__(self, S, c, energy, upper, tol=1e-10, max_iter=50, kink=None, sigma=1e-4,
+                 globalised=True, semismooth=None):
+        self.S, self.c, self.energy, self.upper = S, c, energy, upper
+        self.tol, self.max_iter, self.sigma, self.globalised = tol, max_iter, sigma, globalised
+        self.semismooth_first = globalised if semismooth is None else semismooth
+        self.kink = no_kink() if kink is None else kink
+        self.bounded = np.isfinite(upper)
+        nz = c.size
+        self.diag_S = np.maximum(S.diagonal(), 1e-300) if nz else np.zeros(0)
+        # the contact unknowns among z (all of z, but for the full system of
+        # adhesive_contact.scheme.full_system, whose other entries are interior dofs)
+        self.contact = energy.unknowns
+        self.here = {}
+        self.first_size = None   # the unglobalised method's first iterate size
+
+    # -- the step energy E and its round-off
+
+    def anchor(self, z, E, Sz):
+        """Measure trial energies from the iterate z from now on (:meth:`total`)."""
+        self.here.update(z=z, E=E, g=Sz - self.c, phi=self.energy.value(z))
+
+    def total(self, trial):
+        """E at a trial point as E(z) plus its change from the iterate z,
+        (Sz − c)·Δ + ½ Δ·SΔ + Φ(z + Δ) − Φ(z): ½ zᵀSz − cᵀz itself is a
+        difference of large terms when the body has moved far (|S||z|² ≫
+        |E|), whose round-off would hide the decrease of a last Newton step."""
+        S, c, here = self.S, self.c, self.here
         if not here:
-            return 0.5 * trial @ (S @ trial) - c @ trial + energy.value(trial)
+            return 0.5 * trial @ (S @ trial) - c @ trial + self.energy.value(trial)
         step = trial - here["z"]
         return (here["E"] + here["g"] @ step + 0.5 * step @ (S @ step)
-                + (energy.value(trial) - here["phi"]))
+                + (self.energy.value(trial) - here["phi"]))
 
-    def noise(z, Sz):
-        # round-off of E: below it an energy comparison says nothing
-        return 1e-13 * (0.5 * abs(z @ Sz) + abs(c @ z) + abs(energy.value(z)) + 1e-300)
+    def noise(self, z, Sz):
+        """The round-off of E at z: below it an energy comparison says nothing."""
+        return 1e-13 * (0.5 * abs(z @ Sz) + abs(self.c @ z) + abs(self.energy.value(z))
+                        + 1e-300)
 
-    z = np.minimum(z0, upper)
-    E = total(z)
-    diag_S = np.maximum(S.diagonal(), 1e-300) if nz else np.zeros(0)
-    # the contact unknowns among z (all of z, but for the full system of
-    # adhesive_contact.scheme.full_system, whose other entries are interior dofs)
-    contact = energy.unknowns
-    inner_failures = 0
-    last_residual = None
-    it = 0   # Newton iterations (a chord step is part of the one before it)
-    # a chord step on the last Newton system of S first (that of the last
-    # solve with S: the previous level's, or the previous proximal step's
-    # at t = 0), where S keeps one
-    chord = getattr(S, "chord_start", None) if semismooth else None
-    before_chord = None
-    while True:
-        st = stationarity(S, c, energy, upper, z, kink)
-        if before_chord is not None:
-            # a chord step is kept where it cut the residual CHORD_GAIN-fold
-            # (the superlinear regime it is for), else its start is
-            if st.residual > CHORD_GAIN * before_chord[2].residual >= tol * st.scale:
-                z, E, st = before_chord
-            before_chord = None
-        anchor(z, E, st.Sz)
-        g, xi, s, at_zero, unit = st.g, st.xi, st.s, st.at_zero, st.unit
-        hn, pg, wall, scale, residual = st.hn, st.pg, st.wall, st.scale, st.residual
-        status = (CONVERGED if residual <= tol * scale else
-                  MAX_ITERATIONS if it == max_iter and chord is None else None)
-        if status is not None:
-            break
+    # -- the iteration
 
-        forcing = (min(eisenstat_walker(residual, last_residual), residual / scale)
-                   if globalised else 1e-12)
-        if chord is not None:
-            # a chord step on the last Newton matrix, counted with its iteration
-            accepted, chord = chord_step(S, upper, z, E, st, kink, chord,
-                                         (forcing, 0.5 * tol * scale), total,
-                                         noise(z, st.Sz), sigma), None
-            if accepted is not None:
-                before_chord = (z, E, st)
-                z, E = accepted
-                continue
-            if it == max_iter:
-                status = MAX_ITERATIONS
+    def minimise(self, z0):
+        """The iterations from ``z0`` until the pseudo-gradient is below
+        ``tol`` times the force scale: a :class:`StepResult`."""
+        S, tol, max_iter = self.S, self.tol, self.max_iter
+        z = np.minimum(z0, self.upper)
+        E = self.total(z)
+        self.inner_failures = 0
+        last_residual = None
+        it = 0   # Newton iterations (a chord step is part of the one before it)
+        # a chord step on the last Newton system of S first (that of the last
+        # solve with S: the previous level's, or the previous proximal step's
+        # at t = 0), where S keeps one
+        chord = getattr(S, "chord_start", None) if self.semismooth_first else None
+        before_chord = None
+        while True:
+            st = stationarity(S, self.c, self.energy, self.upper, z, self.kink)
+            if before_chord is not None:
+                # a chord step is kept where it cut the residual CHORD_GAIN-fold
+                # (the superlinear regime it is for), else its start is
+                if st.residual > CHORD_GAIN * before_chord[2].residual >= tol * st.scale:
+                    z, E, st = before_chord
+                before_chord = None
+            self.anchor(z, E, st.Sz)
+            residual, scale = st.residual, st.scale
+            status = (CONVERGED if residual <= tol * scale else
+                      MAX_ITERATIONS if it == max_iter and chord is None else None)
+            if status is not None:
                 break
-        if semismooth:
-            # the semismooth Newton step, its sets free to change; when its
-            # line search fails, the held-direction iteration below
-            accepted, solved, chord = semismooth_step(S, energy, upper, z, E, st, kink,
-                                                      (forcing, 0.5 * tol * scale),
-                                                      total, noise(z, st.Sz), sigma)
-            inner_failures += not solved
-            if chord is not None and hasattr(S, "chord_start"):
-                S.chord_start = chord   # for the next solve with S too
-            if accepted is not None:
-                z, E = accepted
-                last_residual = residual
-                it += 1
-                continue
+            forcing = (min(eisenstat_walker(residual, last_residual), residual / scale)
+                       if self.globalised else 1e-12)
+            accuracy = (forcing, 0.5 * tol * scale)
+            if chord is not None:
+                accepted, chord = self.chord(z, E, st, chord, accuracy), None
+                if accepted is not None:
+                    before_chord = (z, E, st)
+                    z, E = accepted
+                    continue
+                if it == max_iter:
+                    status = MAX_ITERATIONS
+                    break
+            if self.semismooth_first:
+                accepted, chord = self.semismooth(z, E, st, accuracy)
+                if accepted is not None:
+                    z, E = accepted
+                    last_residual = residual
+                    it += 1
+                    continue
+            it += 1
+            status, z, E = self.held_direction(z, E, st, accuracy, it)
+            last_residual = residual
+            if status is not None:
+                break
+        return self.result(z, E, st, status, it)
 
-        # identify the sets with a projected-gradient step length ε
-        it += 1
+    def result(self, z, E, st, status, it):
+        """The StepResult of the last iterate z: its wall multipliers and sets."""
+        message = MESSAGES[status].format(max_iter=self.max_iter, nit=it)
+        if self.inner_failures:
+            message += f" ({self.inner_failures} Newton systems solved inexactly)"
+        return StepResult(z=z, status=status, message=message, nit=it,
+                          residual=st.residual / st.scale, tolerance=self.tol, energy=E,
+                          inner_failures=self.inner_failures,
+                          multiplier=np.where(st.wall, -st.g, 0.0), on_wall=st.wall,
+                          stuck=st.at_zero)
+
+    # -- the strategies
+
+    def chord(self, z, E, st, chord, accuracy):
+        """A chord step on the last Newton matrix (:func:`chord_step`),
+        counted with its iteration: (z, E) or None."""
+        return chord_step(self.S, self.upper, z, E, st, self.kink, chord, accuracy,
+                          self.total, self.noise(z, st.Sz), self.sigma)
+
+    def semismooth(self, z, E, st, accuracy):
+        """The semismooth Newton step, its sets free to change
+        (:func:`semismooth_step`): ((z, E) or None when its line search
+        fails, the chord data of a full step or None)."""
+        S = self.S
+        accepted, solved, chord = semismooth_step(S, self.energy, self.upper, z, E, st,
+                                                  self.kink, accuracy, self.total,
+                                                  self.noise(z, st.Sz), self.sigma)
+        self.inner_failures += not solved
+        if chord is not None and hasattr(S, "chord_start"):
+            S.chord_start = chord   # for the next solve with S too
+        return accepted, chord
+
+    def held_direction(self, z, E, st, accuracy, it):
+        """One iteration with the sets identified by a projected-gradient
+        step length ε and the slip directions held: (status or None, z, E)."""
+        d, stuck = self.held_newton_direction(z, st, accuracy)
+        ref = self.held_slip_directions(d, st, stuck)
+        if not self.globalised:
+            return self.full_step(z, E, d, ref, it)
+        kink, pg, diag_S = self.kink, st.pg, self.diag_S
+        gradient_step = -pg / np.where(diag_S > 0, diag_S, 1.0)
+        if kink.tangential.size:
+            kink.put(gradient_step, stuck, -st.xi)
+        slack = self.noise(z, st.Sz)
+        # the Newton direction, else (nonconvex energy, far from the
+        # solution) the scaled projected gradient, which always descends
+        accepted = backtrack((d, gradient_step),
+                             lambda dz, a: self.project(z + a * dz, ref), self.total,
+                             lambda dz, trial, a: E + self.sigma * self.slope(trial - z, st)
+                             + slack)
+        if accepted is None:
+            return LINE_SEARCH_FAILED, z, E
+        return None, *accepted
+
+    def held_newton_direction(self, z, st, accuracy):
+        """The Newton direction with the binding set moved onto the wall and
+        the stick set put at ξ = 0 and held: (d, stuck)."""
+        S, kink, upper = self.S, self.kink, self.upper
+        tan, kappa, contact = kink.tangential, kink.radius, self.contact
+        g, xi, s, hn, pg = st.g, st.xi, st.s, st.hn, st.pg
         zc = z[contact]
-        width = np.abs(zc - np.minimum(zc - pg[contact] / diag_S[contact],
+        width = np.abs(zc - np.minimum(zc - pg[contact] / self.diag_S[contact],
                                        upper[contact])).max(initial=0.0)
-        binding = bounded & (z >= upper - width) & (g < 0)
+        binding = self.bounded & (z >= upper - width) & (g < 0)
         stuck = (s <= width) & (hn <= kappa)
         fixed = binding.copy()
-        d = np.zeros(nz)
+        d = np.zeros(self.c.size)
         if tan.size:
             kink.put(fixed, stuck, True)
             kink.put(d, stuck, -xi)
         zmax = np.abs(zc).max(initial=0.0)
-        Hphi = energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)   # sparse, nodal blocks
+        Hphi = self.energy.hessian(z, s_floor=1e-12 + 1e-8 * zmax)   # sparse, nodal blocks
         d[binding] = upper[binding] - z[binding]   # onto the wall
         free = ~fixed
         if free.any():
             moved = np.where(fixed, d, 0.0)
             rhs = -pg[free] - ((S @ moved)[free] + (Hphi @ moved)[free])
             # inexact directions need the line search: full steps get exact ones
-            d[free], converged = S.newton_solve(Hphi, rhs, free,
-                                                accuracy=(forcing, 0.5 * tol * scale))
-            inner_failures += not converged
-        last_residual = residual
+            d[free], converged = S.newton_solve(Hphi, rhs, free, accuracy=accuracy)
+            self.inner_failures += not converged
+        return d, stuck
 
-        # slipping directions held for this step
-        ref = unit.copy()
-        if tan.size:
-            start = at_zero & ~stuck
-            pg_tan = kink.take(pg)[start]
+    def held_slip_directions(self, d, st, stuck):
+        """The slip directions held for this step (the unit slips, and
+        −(pseudo-gradient) at a node leaving ξ = 0, whose part of d is
+        put along it): ``ref`` (nkink, d − 1)."""
+        kink = self.kink
+        ref = st.unit.copy()
+        if kink.tangential.size:
+            start = st.at_zero & ~stuck
+            pg_tan = kink.take(st.pg)[start]
             ref[start] = -pg_tan / np.maximum(np.linalg.norm(pg_tan, axis=1), 1e-300)[:, None]
             # a node leaving ξ = 0 moves along its held direction only: the
             # coupled Newton step may point it elsewhere (in 3D), and a slip
@@ -233,53 +314,39 @@ def minimise_step(S, c, energy, upper, z0, tol=1e-10, max_iter=50, kink=None, si
             # with a flat energy the two iterates alternate for ever
             along = np.maximum(np.sum(kink.take(d) * ref, axis=1), 0.0)
             kink.put(d, start, along[:, None] * ref)
+        return ref
 
-        def project(trial):
-            trial = np.minimum(trial, upper)
-            if tan.size:
-                turned = np.sum(kink.xi(trial) * ref, axis=1) <= 0   # stuck nodes reach 0 at α = 1
-                kink.put(trial, turned, 0.0)
-            return trial
+    def project(self, trial, ref):
+        """A trial point onto the wall, and a node whose ξ turned against its
+        held direction ``ref`` to ξ = 0 (stuck nodes reach 0 at α = 1)."""
+        kink = self.kink
+        trial = np.minimum(trial, self.upper)
+        if kink.tangential.size:
+            turned = np.sum(kink.xi(trial) * ref, axis=1) <= 0
+            kink.put(trial, turned, 0.0)
+        return trial
 
-        def slope(step):
-            # E'(z; step): the kink adds κ |Δξ| at nodes where ξ = 0
-            out = g @ step
-            if tan.size:
-                out += kappa[at_zero] @ np.linalg.norm(kink.take(step)[at_zero], axis=1)
-            return out
+    def slope(self, step, st):
+        """E'(z; step): the kink adds κ |Δξ| at nodes where ξ = 0."""
+        kink = self.kink
+        out = st.g @ step
+        if kink.tangential.size:
+            out += kink.radius[st.at_zero] @ np.linalg.norm(kink.take(step)[st.at_zero], axis=1)
+        return out
 
-        # the Newton direction, else (nonconvex energy, far from the
-        # solution) the scaled projected gradient, which always descends
-        slack = noise(z, st.Sz)
-        gradient_step = -pg / np.where(diag_S > 0, diag_S, 1.0)
-        if tan.size:
-            kink.put(gradient_step, stuck, -xi)
-        if not globalised:
-            trial = project(z + d)
-            E_trial = total(trial)
-            size = np.abs(trial).max(initial=0.0)
-            if it == 1:
-                first_size = max(size, np.abs(z).max(initial=0.0), 1e-300)
-            if not (np.isfinite(E_trial) and np.all(np.isfinite(trial))
-                    and size <= 1e8 * first_size):
-                status = DIVERGED
-                break
-            z, E = trial, E_trial
-            continue
-        accepted = backtrack((d, gradient_step), lambda dz, a: project(z + a * dz), total,
-                             lambda dz, trial, a: E + sigma * slope(trial - z) + slack)
-        if accepted is None:
-            status = LINE_SEARCH_FAILED
-            break
-        z, E = accepted
-    # one exit: the wall multipliers and sets of the last iterate z
-    message = MESSAGES[status].format(max_iter=max_iter, nit=it)
-    if inner_failures:
-        message += f" ({inner_failures} Newton systems solved inexactly)"
-    return StepResult(z=z, status=status, message=message, nit=it,
-                      residual=residual / scale, tolerance=tol, energy=E,
-                      inner_failures=inner_failures, multiplier=np.where(wall, -g, 0.0),
-                      on_wall=wall, stuck=at_zero)
+    def full_step(self, z, E, d, ref, it):
+        """The unglobalised iteration ("newton-plain"): the full projected
+        step, DIVERGED when E or the iterate stops being finite or the
+        iterate grows past 1e8 times the size of the first one."""
+        trial = self.project(z + d, ref)
+        E_trial = self.total(trial)
+        size = np.abs(trial).max(initial=0.0)
+        if it == 1:
+            self.first_size = max(size, np.abs(z).max(initial=0.0), 1e-300)
+        if not (np.isfinite(E_trial) and np.all(np.isfinite(trial))
+                and size <= 1e8 * self.first_size):
+            return DIVERGED, z, E
+        return None, trial, E_trial
 
 
 @dataclass
