@@ -53,10 +53,12 @@ def check(scene, resolved):
     click.echo(f"  time: {time_line(parsed)}")
     click.echo(f"  estimate: {est.describe()}")
     if getattr(problem.bonding, "rate_independent", False):
-        from adhesive_contact.problem.warnings import DAMAGE_DROP
+        from adhesive_contact.problem.damage_lag import DAMAGE_DROP, GLUE_ENERGY_MARGIN
         click.echo("  damage update of the cohesive law: beta stays in [0, 1] for every k; "
                    "its one-level lag is checked after the run (a warning when a facet "
-                   f"loses more than {DAMAGE_DROP:g} of its bond in one level)")
+                   f"loses more than {DAMAGE_DROP:g} of its bond in one level or the glue "
+                   f"dissipates more than {1 + GLUE_ENERGY_MARGIN:g} G_c per debonded area, "
+                   "and where the quasi-static path jumps)")
     elif problem.bonding is not None:
         bound = problem.bonding.stable_step()
         click.echo(f"  explicit Euler bound of the bonding law: k <= {bound:.4g} "

@@ -212,8 +212,8 @@ class CohesiveDamage:
     fixed mixity β_n = P_B β*(max_{j<n} δ_m,j) and unloading follows the
     damaged secant β K. β stays in [0, 1] for every k (no bound like the
     Frémond one: :meth:`stable_step` is ∞); the lag of one level makes the
-    traction overshoot the envelope by at most β K Δδ per level, checked
-    after a run (:func:`adhesive_contact.problem.warnings.damage_lag_warning`).
+    traction overshoot the envelope by at most β K Δδ per level, read from a
+    finished run (:mod:`adhesive_contact.problem.damage_lag`).
     """
 
     normal: CohesiveNormal

@@ -25,6 +25,7 @@ import numpy as np
 from ..laws.bonding import BEYOND_TIME_SCALE
 from .accuracy import (MEMORY_GUIDE, bonding_time_scale, memory_error, shortest_relaxation_time,
                        steps_for_memory, steps_for_time_scale)
+from .damage_lag import DAMAGE_DROP, GLUE_ENERGY_MARGIN, JUMP_RATIO, MAX_REFINEMENT, read_lag
 from .plausibility import plausibility_warnings
 
 #: the largest principal strain |ε| the small-strain model is taken to represent
@@ -258,38 +259,129 @@ def memory_step_warning(problem):
             + " (docs/scheme.md#accuracy-guides-of-the-time-step)")
 
 
-#: a rate-independent damage update warns when a facet loses more than this
-#: fraction of its bond in one level
-DAMAGE_DROP = 0.1
+#: where docs/model.md describes the cohesive damage update and its lag
+COHESIVE_DOCS = "docs/model.md#44-the-cohesive-law-law--cohesive-in-both-tables"
 
 
-def damage_lag_warning(solution):
-    """A line when the damage update of a rate-independent bonding law (the
-    cohesive one) lost more than DAMAGE_DROP of a facet's bond in one level.
+def steps_advice(problem, refinement):
+    """"use at least time.steps = N'" for steps ``refinement`` times shorter
+    (an adaptive run: a smaller tol, its k_max being T/steps)."""
+    scene = problem.scene
+    if scene.adaptive is not None:
+        return (f"steps about {refinement:.3g} times shorter where it debonds (a smaller "
+                f"time.adaptive.tol, or more time.steps: k_max = T/steps)")
+    return f"use at least time.steps = {int(np.ceil(scene.steps * refinement - 1e-9))}"
 
-    The update β_n = min(β_{n−1}, β*(u_{n−1})) lags the opening by one
-    level: β_n ∈ [0, 1] for every k, but level n's traction β_{n−1} K δ_n
-    exceeds the envelope by up to β_{n−1} K (δ_n − δ_{n−1}), and the glue's
-    dissipation exceeds G_c by a fraction that falls with the largest drop
-    max_{n,f} (β_{n−1,f} − β_{n,f}) (first order in k). ``solution.beta``
-    is (levels, nf)."""
+
+def toughness_name(problem):
+    """G_c, or max(G_Ic, G_IIc) of a mixed-mode law (:mod:`.damage_lag`, 3)."""
+    return "max(G_Ic, G_IIc)" if getattr(problem.normal_law, "mixed", False) else "G_c"
+
+
+def glue_energy_phrase(problem, energy):
+    """"the glue dissipated R × G_c per debonded area (...)"."""
+    name = toughness_name(problem)
+    return (f"the glue dissipated {energy.ratio:.3g} × {name} per debonded area "
+            f"({energy.dissipated:.4g} against {name} ∫(β_0 − β) = "
+            f"{energy.toughness_work:.4g} over the glue bonded at t = 0)")
+
+
+def jump_warning(solution, reading):
+    """The line of a jump of the quasi-static path (:func:`.damage_lag.find_jump`):
+    where and when, what the run shows of it, why no step count helps and
+    what does."""
+    jump, problem = reading.jump, solution.problem
+    point = "(" + ", ".join(f"{c:.3g}" for c in jump.point) + ")"
+    shown = []
+    if reading.worst > DAMAGE_DROP:
+        shown.append(f"the damage update lost up to {reading.worst:.2g} of a facet's bond in "
+                     f"one level at {step_list(reading.drop_levels, solution.t)}")
+    ratio = reading.energy.ratio
+    if ratio is not None and ratio > 1.0 + GLUE_ENERGY_MARGIN:
+        shown.append(glue_energy_phrase(problem, reading.energy))
+    return (f"the quasi-static path jumps at step {jump.level} (t = {jump.t:.4g}), or nearly "
+            f"does: the glue near {point} opened from {jump.before:.3g} to {jump.after:.3g} in "
+            f"that step, {jump.ratio:.3g} times what the loading moved in it, the body "
+            f"springing back into a glue that softens faster than the body between it and "
+            f"the load can follow; "
+            + ("; ".join(shown) + "; " if shown else "")
+            + "the cohesive damage update follows a jump one level late, in steps whose "
+            "falls of the bond do not shrink with k, so more steps do not silence this (near "
+            "a jump, only very many do). Prescribe the opening itself (a displacement at the "
+            "crack mouth, next to the glue) or load the glue through a stiffer grip (a stiffer "
+            f"or shorter body between the load and the glue) ({COHESIVE_DOCS})")
+
+
+def damage_drop_warning(solution, reading):
+    """The line of falls of β above DAMAGE_DROP in one level along a path
+    without a jump, with the steps that bring them below
+    (:func:`.damage_lag.steps_for_drop`)."""
     problem = solution.problem
-    if not getattr(problem.bonding, "rate_independent", False):
-        return None
-    beta = np.asarray(solution.beta)
-    if beta.shape[0] < 2 or not beta.shape[1]:
-        return None
-    drop = beta[:-1] - beta[1:]
-    worst = float(drop.max())
-    if worst <= DAMAGE_DROP:
-        return None
-    steps = tuple(int(n) for n in np.flatnonzero(drop.max(axis=1) > DAMAGE_DROP) + 1)
-    need = int(np.ceil(problem.scene.steps * worst / DAMAGE_DROP))
+    if np.isfinite(reading.refinement):
+        advice = (f"along this run's openings, {steps_advice(problem, reading.refinement)} "
+                  f"to keep the falls below {reading.target:.2g} ({DAMAGE_DROP:g}, with a "
+                  f"margin for the lag's own error in the openings)")
+    else:
+        advice = (f"along this run's openings even steps {MAX_REFINEMENT} times shorter leave "
+                  f"falls above {reading.target:.2g}: "
+                  + steps_advice(problem, float(MAX_REFINEMENT)).replace("at least", "more than"))
     return (f"the cohesive damage update lags the opening by one level and lost up to "
-            f"{worst:.2g} of a facet's bond in one level at {step_list(steps, solution.t)}, "
-            f"so the peak traction is overshot and the glue dissipates more than the "
-            f"toughness (first order in k): use at least time.steps = {need} for drops "
-            f"below {DAMAGE_DROP:g} (docs/model.md#44-the-cohesive-law-law--cohesive-in-both-tables)")
+            f"{reading.worst:.2g} of a facet's bond in one level at "
+            f"{step_list(reading.drop_levels, solution.t)}, so the peak traction is "
+            f"overshot and the glue dissipates more than the toughness (first order in k): "
+            f"{advice}{jump_hint(solution, reading)} ({COHESIVE_DOCS})")
+
+
+def jump_hint(solution, reading):
+    """"; the glue near x opened J times ..." when an opening outran the
+    loading (J ≥ OPENING_RATIO) without reaching JUMP_RATIO, else ""."""
+    fast = reading.fastest
+    if fast is None:
+        return ""
+    problem = solution.problem
+    point = "(" + ", ".join(f"{c:.3g}" for c in fast.point) + ")"
+    tell = (f"time.steps = {int(np.ceil(problem.scene.steps * reading.steps_to_tell))}"
+            if problem.scene.adaptive is None else
+            f"steps {reading.steps_to_tell:.3g} times shorter")
+    return (f"; at step {fast.level} (t = {fast.t:.4g}) the glue near {point} opened "
+            f"{fast.ratio:.3g} times what the loading moved in it, the body springing back "
+            f"into it: if the path jumps there, more steps do not silence this, and a run at "
+            f"{tell} would show it (more than {JUMP_RATIO:g} times)")
+
+
+def glue_energy_warning(solution, reading, hint=True):
+    """The line of a glue that dissipated more than (1 + GLUE_ENERGY_MARGIN)
+    G_c per debonded area along a path without a jump, with the steps that
+    bring the excess (first order in k) below the margin; ``hint``: with
+    :func:`jump_hint`."""
+    problem, energy = solution.problem, reading.energy
+    refinement = (energy.ratio - 1.0) / GLUE_ENERGY_MARGIN
+    return (f"{glue_energy_phrase(problem, energy)}, more than the {100 * GLUE_ENERGY_MARGIN:g} % "
+            f"the one-level lag of the cohesive damage update adds at resolved steps: the "
+            f"excess is first order in k and falls faster than k at coarse steps, so "
+            f"{steps_advice(problem, refinement).replace('use at least ', '')} brings it "
+            f"below{jump_hint(solution, reading) if hint else ''} ({COHESIVE_DOCS})")
+
+
+def damage_lag_warnings(solution):
+    """The lines of :func:`.damage_lag.read_lag` for a run of a rate-independent
+    bonding law (the cohesive one): a jump of the quasi-static path, named,
+    in place of the others (no step count silences them); else falls of β
+    above DAMAGE_DROP in one level and a glue energy above (1 +
+    GLUE_ENERGY_MARGIN) G_c per debonded area, each with the steps that
+    bring it below."""
+    reading = read_lag(solution)
+    if reading is None:
+        return []
+    ratio = reading.energy.ratio
+    excess = ratio is not None and ratio > 1.0 + GLUE_ENERGY_MARGIN
+    if reading.worst <= DAMAGE_DROP and not excess:
+        return []
+    if reading.jump is not None:
+        return [jump_warning(solution, reading)]
+    drops = reading.worst > DAMAGE_DROP
+    return ([damage_drop_warning(solution, reading)] if drops else []) \
+        + ([glue_energy_warning(solution, reading, hint=not drops)] if excess else [])
 
 
 def stiffness_warning(problem):
@@ -329,5 +421,5 @@ def problem_warnings(problem):
 def solution_warnings(solution):
     """The lines of the checks of a finished run that apply."""
     return [w for w in (nonconvex_step_warning(solution), two_solutions_warning(solution),
-                        geometry_warning(solution), damage_lag_warning(solution))
-            if w is not None]
+                        geometry_warning(solution))
+            if w is not None] + damage_lag_warnings(solution)
