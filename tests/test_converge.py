@@ -18,7 +18,7 @@ from skfem.helpers import ddot, sym_grad
 import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, build_problem, parse_scene, solve
 from adhesive_contact.studies.convergence import trust
-from adhesive_contact.verification.levels import default_reference_refinement, run_reference
+from adhesive_contact.studies.levels import default_reference_refinement, run_reference
 
 
 # no contact: u* is smooth and the library derives body force and tractions;

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from adhesive_contact import build_problem, parse_scene, solve
-from adhesive_contact.verification.levels import with_discretisation
+from adhesive_contact.studies.levels import with_discretisation
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = {
@@ -34,3 +34,4 @@ def test_scene_problem_solution_pickle_and_run_the_same(name):
     copy = pickle.loads(pickle.dumps(first))
     np.testing.assert_array_equal(copy.u, first.u)
     assert copy.status == first.status and copy.message == first.message
+

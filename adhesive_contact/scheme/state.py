@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .bonding import FacetRate, advance, damage
+from ..bonding import FacetRate, advance, damage
 from .contact_energy import ContactEnergy
 from ..expressions import coordinates
 from ..step_methods import MAX_ITERATIONS, Kink, StepOptions, minimise

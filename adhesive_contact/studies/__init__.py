@@ -5,7 +5,8 @@
 missing); :mod:`.pool` runs the runs in this process, in local worker
 processes or on any executor; :mod:`.executors` is the executor of a
 ``dask.distributed`` cluster; :mod:`.convergence` is the convergence study
-in h, k or both, :mod:`.sweep` a parameter sweep.
+in h, k or both (a level and the reference run by :mod:`.levels`),
+:mod:`.sweep` a parameter sweep.
 """
 
 from .convergence import ConvergenceResult, ConvergenceStudy

@@ -1,15 +1,15 @@
 """Convergence studies in h, k or both, kept in a folder (docs/verification.md).
 
-The computation of one level and of the fine reference is
-:mod:`adhesive_contact.verification.levels`; :class:`ConvergenceStudy` is the
-study on top of :class:`~adhesive_contact.studies.study.Study`. Its folder:
+The computation of one level and of the fine reference is :mod:`.levels`;
+:class:`ConvergenceStudy` is the study on top of
+:class:`~adhesive_contact.studies.study.Study`. Its folder:
 
 - ``study.json``: the resolved scene (level 0), param, levels, reference
   kind, ref_h and ref_k, and the sha256 of exactly that;
 - ``reference.npz`` (reference ``"fine"``): the reference run's t, u, beta,
   facets, its refine and steps and its wall time, saved once computed;
-- ``levels/level_NN.json``: one record of
-  :func:`~adhesive_contact.verification.levels.run_level` per finished level;
+- ``levels/level_NN.json``: one record of :func:`~.levels.run_level` per
+  finished level;
 - ``errors.csv`` and ``rates.json`` (:func:`results`): rewritten from the
   saved records at the end of every completed run.
 
@@ -46,7 +46,11 @@ from ..postprocess.scalars import (quantity_kind, quantity_names, quantity_unava
 from ..postprocess.units import unit_of
 from ..problem.build import build_problem
 from ..verification.rates import pairwise_rates, rates
-from ..verification.levels import (
+from ..fem.meshes import build_mesh
+from ..scene import SceneError, scene_from_dict
+from ..scene.materials import check_relaxation_step
+from ..storage import write_atomic, write_csv, write_json
+from .levels import (
     PARAMS,
     Reference,
     default_reference_refinement,
@@ -57,10 +61,6 @@ from ..verification.levels import (
     run_reference,
     with_discretisation,
 )
-from ..fem.meshes import build_mesh
-from ..scene import SceneError, scene_from_dict
-from ..scene.materials import check_relaxation_step
-from ..storage import write_atomic, write_csv, write_json
 from .pool import attempt, in_this_process
 from .study import RunFailed, Study, StudyError, scene_identity, scene_source
 
@@ -347,7 +347,7 @@ class ConvergenceStudy(Study):
     ref_h, ref_k : int, optional
         The fine reference has ``ref_h`` more mesh refinements and
         ``2**ref_k`` times the steps of the finest level
-        (default :func:`~adhesive_contact.verification.levels.default_reference_refinement`);
+        (default :func:`~.levels.default_reference_refinement`);
         only with ``reference="fine"``.
     refine, steps : int, optional
         Mesh refinement and steps of level 0 instead of the scene's.

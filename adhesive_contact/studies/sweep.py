@@ -38,10 +38,13 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import SceneError, build_problem, scene_from_dict, solve
+from ..errors import SceneError
 from ..postprocess.scalars import quantity_kind, scalar_quantities, state_quantities
 from ..postprocess.units import with_unit
+from ..problem import build_problem
 from ..problem.warnings import solution_warnings
+from ..scene import scene_from_dict
+from ..scheme import solve
 from ..storage import plain, toml_value, write_csv
 from .study import Study, StudyError, scene_identity, scene_source
 
