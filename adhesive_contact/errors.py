@@ -32,7 +32,11 @@ class SceneError(ValueError):
 
     def __init__(self, key, message):
         self.key = key
+        self.reason = message
         super().__init__(f"{shown_key(key)}: {message}" if key else message)
+
+    def __reduce__(self):   # survive the trip back from a worker process
+        return type(self), (self.key, self.reason)
 
 
 def where(points, index=None, t=None, digits=6):
