@@ -9,7 +9,7 @@ in h, k or both (a level and the reference run by :mod:`.levels`),
 :mod:`.sweep` a parameter sweep.
 """
 
-from .convergence import ConvergenceResult, ConvergenceStudy
+from .convergence import ConvergenceResult, ConvergenceStudy, LevelRow
 from .executors import ClusterError, DaskExecutor, dask_executor
 from .pool import execute
 from .study import (
@@ -21,9 +21,9 @@ from .study import (
     StudyMismatch,
     study_document,
 )
-from .sweep import Sweep, SweepResult
+from .sweep import Sweep, SweepResult, SweepRow
 
-__all__ = ["ClusterError", "ConvergenceResult", "ConvergenceStudy", "DaskExecutor",
+__all__ = ["ClusterError", "ConvergenceResult", "ConvergenceStudy", "LevelRow", "DaskExecutor",
            "dask_executor", "execute", "RunFailed", "RunStore",
            "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document",
-           "Sweep", "SweepResult"]
+           "Sweep", "SweepResult", "SweepRow"]
