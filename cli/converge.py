@@ -14,12 +14,12 @@ from pathlib import Path
 
 import click
 
-from adhesive_contact.verification.levels import PARAMS, level_scene
 from adhesive_contact.studies import (
     ConvergenceStudy,
     RunFailed,
 )
 from adhesive_contact.studies.convergence import MEANINGFUL_LEVELS
+from adhesive_contact.studies.levels import PARAMS, level_scene
 from adhesive_contact.visuals import write_convergence_plots
 from adhesive_contact.visuals.studies import reference_phrase
 

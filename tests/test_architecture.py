@@ -1,7 +1,7 @@
-"""The layout of docs/architecture.md holds: each package imports only what
-its row of "What may import what" allows, the library never imports the
-command line, the command line draws nothing itself, and no module grows
-past 700 lines."""
+"""The layout of docs/architecture.md holds: the package is a stack of
+floors and each module imports only its own package and the floors below
+it, the library never imports the command line, the command line draws
+nothing itself, and no module grows past 700 lines."""
 
 import ast
 import re
@@ -13,29 +13,25 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "adhesive_contact"
 CLI = ROOT / "cli"
 
-BASE = {"expressions", "storage", "threads", "laws", "step_methods", "linear_solvers"}
-#: package -> what it may import (docs/architecture.md); a dotted entry
-#: allows one module of a package
-ALLOWED = {
-    "expressions": set(), "storage": set(), "threads": set(), "laws": set(),
-    "step_methods": set(),
-    "linear_solvers": set(), "folders": {"storage"},
-    "scene": {"expressions", "laws", "step_methods", "linear_solvers", "scheme.bonding",
-              "verification.manufactured", "fem.meshes.builtin"},
-    "fem": {"expressions", "scene"},
-    "problem": {"expressions", "scene", "laws", "fem", "verification.manufactured",
-                "verification.admissibility", "scheme.options"},
-    "scheme": {"expressions", "threads", "scene", "laws", "step_methods", "linear_solvers"},
-    "verification": BASE | {"scene", "fem", "problem", "scheme"},
-    "postprocess": {"expressions", "threads", "fem"},
-    "visuals": {"postprocess", "storage"},
-    "io": {"scene", "problem", "scheme", "postprocess", "visuals", "resources", "folders",
-           "storage", "threads"},
-    "resources": {"scene", "fem", "linear_solvers", "scheme"},
-    "studies": BASE | {"scene", "fem", "problem", "scheme", "verification", "postprocess",
-                       "io", "resources", "folders", ""},
-    "": None,   # adhesive_contact/__init__.py: the public names, from anywhere
-}
+#: the floors of the package, from the ground up (docs/architecture.md, "The
+#: layers"): a module imports its own package and the packages of lower
+#: floors, never one of its own floor or above; "" is the package's face
+#: (adhesive_contact/__init__.py: the public names)
+LAYERS = (
+    ("expressions", "storage", "threads", "errors", "laws", "bonding", "step_methods",
+     "linear_solvers"),
+    ("folders", "fem"),
+    ("verification",),
+    ("scene",),
+    ("scheme",),
+    ("problem", "resources"),
+    ("postprocess",),
+    ("visuals",),
+    ("io",),
+    ("studies",),
+    ("",),
+)
+FLOOR = {package: floor for floor, packages in enumerate(LAYERS) for package in packages}
 
 
 def _modules():
@@ -69,17 +65,17 @@ def _package_of(module):
 
 
 def _allowed(importer, target):
-    rules = ALLOWED[importer]
-    if rules is None or _package_of(target) == importer:
-        return True
+    """``importer``'s package may import ``target`` (a module, or a name
+    of the package's face): its own package or one on a lower floor."""
     parts = target.split(".")[1:]
-    return any(".".join(parts[:i]) in rules for i in range(1, len(parts) + 1)) or (
-        "" in rules and len(parts) == 1 and parts[0] not in ALLOWED)
+    package = parts[0] if parts and parts[0] in FLOOR else ""
+    return package == importer or FLOOR[package] < FLOOR[importer]
 
 
-def test_every_package_has_a_row():
+def test_every_package_is_on_one_floor():
     packages = {_package_of(module) for _, module, _ in _modules()}
-    assert packages == set(ALLOWED)
+    assert packages == set(FLOOR)
+    assert sum(len(floor) for floor in LAYERS) == len(FLOOR)
 
 
 @pytest.mark.parametrize("path,module,is_package", list(_modules()),

@@ -16,7 +16,7 @@ from conftest import law, scene_dict
 from adhesive_contact import build_problem, scene_from_dict
 from adhesive_contact.laws import CohesiveDamage, CohesiveNormal
 from adhesive_contact.scene import SceneError
-from adhesive_contact.scheme.bonding import damage
+from adhesive_contact.bonding import damage
 
 SIGMA, G1, G2, K, ETA = 2.0, 0.05, 0.15, 1.0e4, 1.7
 

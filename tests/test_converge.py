@@ -18,7 +18,7 @@ from skfem.helpers import ddot, sym_grad
 import adhesive_contact.studies.convergence as converge_module
 from adhesive_contact import StepFailure, build_problem, parse_scene, solve
 from adhesive_contact.studies.convergence import trust
-from adhesive_contact.verification.levels import default_reference_refinement, run_reference
+from adhesive_contact.studies.levels import default_reference_refinement, run_reference
 
 
 # no contact: u* is smooth and the library derives body force and tractions;
@@ -544,3 +544,45 @@ def test_steps_that_the_relaxation_check_refuses_are_refused_before_the_study(tm
     assert_one_line_error(result, 2, "--steps: the time step k = 1 is too large for the "
                           "relaxation time tau = 0.05")
     assert not out.exists()
+
+
+def test_errors_csv_and_rates_json_rows_are_the_level_records(tmp_path):
+    """LevelRow puts each entry of a level record under its column: errors.csv
+    holds the level's size, errors, time and relative errors, the pairwise
+    rate of E (log(E_a/E_b)/log(h_a/h_b), the first level none), and in a
+    study of a quantity Q_h, |Q_h − Q_ref|, that over |Q_ref| and its rate;
+    a relative error saved as NaN or not at all is an empty cell; rates.json
+    keeps its level entries in their documented order."""
+    import math
+
+    records = [
+        {"level": 0, "refine": 0, "steps": 4, "h": 0.5, "k": 0.25, "dofs": 30,
+         "err_u": 0.04, "err_beta": 0.0, "E": 0.04, "seconds": 0.5, "rel_u": 0.2,
+         "rel_beta": math.nan, "rel_E": 0.2, "newton_iterations": 9,
+         "quantities": {"q": 2.5}},
+        {"level": 1, "refine": 1, "steps": 4, "h": 0.25, "k": 0.25, "dofs": 90,
+         "err_u": 0.01, "err_beta": 0.0, "E": 0.01, "seconds": 1.5,
+         "newton_iterations": 11, "quantities": {"q": 2.125}},
+    ]
+    document = converge_module.results(records, "h", {"kind": "fine", "quantity": 2.0}, "q")
+    assert list(document["levels"][0]) == [
+        "h", "k", "dofs", "err_u", "err_beta", "E", "seconds", "rel_u", "rel_beta", "rel_E",
+        "level", "steps", "refine", "rate_E", "newton_iterations",
+        "quantity", "err_q", "rel_q", "rate_q"]
+    converge_module.write_errors_csv(tmp_path / "errors.csv", document)
+    with open(tmp_path / "errors.csv", newline="") as f:
+        header, *cells = list(csv.reader(f))
+    assert header == CSV_COLUMNS + ["quantity", "err_q", "rel_q", "rate_q"]
+    rate_e = math.log(0.04 / 0.01) / math.log(0.5 / 0.25)
+    rate_q = math.log(0.5 / 0.125) / math.log(0.5 / 0.25)
+    assert cells[0] == ["0", "0.5", "0.25", "30", "4", "0.04", "0.0", "0.04", "", "0.5",
+                        "0.2", "", "0.2", "2.5", "0.5", "0.25", ""]
+    assert cells[1][:13] == ["1", "0.25", "0.25", "90", "4", "0.01", "0.0", "0.01",
+                             repr(rate_e), "1.5", "", "", ""]
+    assert cells[1][13:16] == ["2.125", "0.125", "0.0625"]
+    assert float(cells[1][16]) == pytest.approx(rate_q, rel=1e-15)
+    plain = converge_module.results(records, "h", {"kind": "fine"})
+    assert "quantity" not in plain["levels"][1]
+    converge_module.write_errors_csv(tmp_path / "plain.csv", plain)
+    with open(tmp_path / "plain.csv", newline="") as f:
+        assert [row[:9] for row in csv.reader(f)][1:] == [c[:9] for c in cells]

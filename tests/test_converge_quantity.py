@@ -18,7 +18,7 @@ from adhesive_contact.fem.meshes import mesh_size
 from adhesive_contact.postprocess import reaction_sides, reactions
 from adhesive_contact.problem.build import build_problem
 from adhesive_contact.scheme import solve
-from adhesive_contact.verification.levels import level_scene, reference_scene
+from adhesive_contact.studies.levels import level_scene, reference_scene
 
 # a block hanging from its top, pressed by its weight onto a compliant wall
 # whose gap varies along x: the top's vertical reaction changes with the mesh

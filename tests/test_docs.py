@@ -277,7 +277,7 @@ def test_the_readme_scene_table_names_every_law_and_integrator():
     coulomb and cohesive were, is a law a new user does not find)."""
     from adhesive_contact.laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
     from adhesive_contact.scene.keys import KEYS
-    from adhesive_contact.scheme.bonding import INTEGRATORS
+    from adhesive_contact.bonding import INTEGRATORS
     wanted = {"[contact.normal]": NORMAL_LAWS, "[contact.friction]": FRICTION_LAWS,
               "[contact.bonding]": {**BONDING_LAWS, **INTEGRATORS}}
     for table, names in wanted.items():

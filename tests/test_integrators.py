@@ -22,8 +22,8 @@ from conftest import law, run, scene_dict
 from scipy.integrate import solve_ivp
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
-from adhesive_contact.scheme.bonding import INTEGRATORS, FacetRate, advance
-from adhesive_contact.verification.levels import with_discretisation
+from adhesive_contact.bonding import INTEGRATORS, FacetRate, advance
+from adhesive_contact.studies.levels import with_discretisation
 from adhesive_contact.laws import Fremond
 from adhesive_contact.laws.bonding import BEYOND_TIME_SCALE
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from adhesive_contact import build_problem, parse_scene, solve
-from adhesive_contact.verification.levels import with_discretisation
+from adhesive_contact.studies.levels import with_discretisation
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = {
@@ -34,3 +34,20 @@ def test_scene_problem_solution_pickle_and_run_the_same(name):
     copy = pickle.loads(pickle.dumps(first))
     np.testing.assert_array_equal(copy.u, first.u)
     assert copy.status == first.status and copy.message == first.message
+
+
+def test_a_scene_error_pickles_whole():
+    """A SceneError raised in a worker comes back as it was raised: its type,
+    its key (whole, however long) and its one-line message; it is one class
+    under each name it is imported by."""
+    import adhesive_contact
+    import adhesive_contact.errors
+    import adhesive_contact.scene
+
+    assert adhesive_contact.SceneError is adhesive_contact.scene.SceneError
+    assert adhesive_contact.scene.SceneError is adhesive_contact.errors.SceneError
+    for key in ("contact.normal.c", "k" * 200, None):
+        err = adhesive_contact.SceneError(key, "must be > 0, got -1")
+        again = pickle.loads(pickle.dumps(err))
+        assert type(again) is adhesive_contact.SceneError
+        assert (again.key, str(again)) == (err.key, str(err))

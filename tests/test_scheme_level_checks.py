@@ -10,7 +10,7 @@ import pytest
 from conftest import level_zero_input, scene_dict
 
 from adhesive_contact import SceneError, build_problem, parse_scene, scene_from_dict, solve
-from adhesive_contact.verification.levels import with_discretisation
+from adhesive_contact.studies.levels import with_discretisation
 from adhesive_contact.scheme import STEP_FAILED, InvalidState
 from adhesive_contact.scheme.level_checks import check_level
 from adhesive_contact.scheme.operators import StepOperators

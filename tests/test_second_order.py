@@ -30,11 +30,11 @@ from scipy.integrate import solve_ivp
 
 from adhesive_contact import SceneError, build_problem, scene_from_dict, solve
 from adhesive_contact.laws import Fremond
-from adhesive_contact.scheme.bonding import FacetRate, advance
+from adhesive_contact.bonding import FacetRate, advance
 from adhesive_contact.scheme.memory import FunctionMemory
 from test_scheme_memory import prony_memory, uniform
 from adhesive_contact import compile_expression
-from adhesive_contact.verification.levels import run_level, run_reference
+from adhesive_contact.studies.levels import run_level, run_reference
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE_A = ROOT / "studies" / "convergence" / "a_separated_slipping.toml"

@@ -377,3 +377,43 @@ def test_a_value_nested_too_deeply_is_one_line():
         parse_assignment("title=" + "[" * 3000 + "]" * 3000)
     assert parse_assignment('title="' + "[" * 40 + '"') == ("title", ["[" * 40])
     assert parse_assignment("mesh.cells=[[8, 4]]") == ("mesh.cells", [[[8, 4]]])
+
+
+def test_runs_csv_rows_are_the_records_cells_in_column_order(tmp_path):
+    """SweepRow puts each value of a run record under its column: the swept
+    values, the measured columns, the failure's step and time, the scalar
+    quantities (a quantity a run lacks, and whatever a failed or lost run
+    has not, an empty cell); the message is the row's, not a column."""
+    from adhesive_contact.studies.sweep import (MEASURED, SweepRow, lost_record,
+                                                write_runs_csv)
+
+    keys = ["contact.normal.c", "title"]
+    measured = {column: None for column in MEASURED[3:]}
+    ok = {"run": 0, "values": {"contact.normal.c": 1000.0, "title": "a"}, "outcome": "ok",
+          "failure": None, **measured, "residual": 2.5e-13, "seconds": 0.125,
+          "newton_total": 7, "newton_max": 3, "separated_T": 4,
+          "quantities": {"work_T": 0.1, "reaction_top_y_T": -3.0}}
+    failed = {"run": 1, "values": {"contact.normal.c": 5000.0, "title": "b"},
+              "outcome": "failed", "residual": 0.25, "seconds": 0.5,
+              "failure": {"step": 2, "t": 0.5, "residual": 0.25, "iterations": 1,
+                          "message": "step 2 did not converge"}}
+    lost = lost_record(2, {"contact.normal.c": 1e4, "title": "c"}, "its worker died")
+    quantities = ["work_T", "reaction_top_y_T"]
+    rows = [SweepRow.of(record, keys, quantities) for record in (ok, failed, lost)]
+    assert (rows[1].outcome, rows[1].failed_step, rows[1].failed_t) == ("failed", 2, 0.5)
+    assert rows[1]["message"] == "step 2 did not converge" and rows[0].message is None
+    assert rows[2]["outcome"] == "lost" and rows[2].get("work_T") is None
+    assert rows[0]["title"] == "a" and rows[0].get("no such column", "-") == "-"
+    write_runs_csv(tmp_path / "runs.csv", rows, keys, quantities)
+    with open(tmp_path / "runs.csv", newline="") as f:
+        header, *cells = list(csv.reader(f))
+    assert header == ["run", *keys, *MEASURED, *quantities]
+    expected = [
+        {"run": "0", "contact.normal.c": "1000.0", "title": "a", "outcome": "ok",
+         "residual": "2.5e-13", "seconds": "0.125", "newton_total": "7", "newton_max": "3",
+         "separated_T": "4", "work_T": "0.1", "reaction_top_y_T": "-3.0"},
+        {"run": "1", "contact.normal.c": "5000.0", "title": "b", "outcome": "failed",
+         "failed_step": "2", "failed_t": "0.5", "residual": "0.25", "seconds": "0.5"},
+        {"run": "2", "contact.normal.c": "10000.0", "title": "c", "outcome": "lost"},
+    ]
+    assert cells == [[want.get(column, "") for column in header] for want in expected]

@@ -11,7 +11,7 @@ from skfem import Basis, ElementTriP1
 
 from adhesive_contact import build_problem, parse_scene, scene_from_dict
 from adhesive_contact.fem.assembly import stiffness_basis, strain_map
-from adhesive_contact.verification.levels import run_level, run_reference
+from adhesive_contact.studies.levels import run_level, run_reference
 from adhesive_contact.verification.rates import rates
 from adhesive_contact.verification.errors import (
     cell_volumes,

@@ -207,7 +207,7 @@ class CohesiveDamage:
 
     β* of the normal law (:meth:`CohesiveNormal.intact`) at the facet's
     root-mean-square openings (one damage per facet; see
-    :mod:`adhesive_contact.scheme.bonding.damage` for why r.m.s.). β_{n−1} is the
+    :mod:`adhesive_contact.bonding.damage` for why r.m.s.). β_{n−1} is the
     history variable: β* decreases with the effective opening, so at a
     fixed mixity β_n = P_B β*(max_{j<n} δ_m,j) and unloading follows the
     damaged secant β K. β stays in [0, 1] for every k (no bound like the

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..expressions import coordinates
 from ..fem.dirichlet import rigid_modes
-from ..scene.errors import SceneError, where
+from ..errors import SceneError, where
 from ..scene.keys import MAX_HALVINGS
 
 #: time levels sampled besides t = 0 and t = T (where not every level is)

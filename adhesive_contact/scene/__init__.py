@@ -7,7 +7,8 @@ found. Every key is checked: a missing, unknown or wrongly typed key, or a
 value outside its range, raises :class:`SceneError` whose message is one
 line that names the key and says what is allowed.
 
-- :mod:`.errors`: :class:`SceneError`;
+- :class:`SceneError` (of :mod:`adhesive_contact.errors`, at the base of
+  the package, so that the meshes below the scene raise it too);
 - :mod:`.spec`: the dataclasses of a validated scene, :class:`Scene` and
   one per table;
 - :mod:`.record`: the resolved record (:attr:`Scene.resolved`);
@@ -19,7 +20,7 @@ line that names the key and says what is allowed.
 - :mod:`.parse`: the scene from a file, a TOML text or a dictionary.
 """
 
-from .errors import SceneError, where
+from ..errors import SceneError, where
 from .materials import relaxation_step_definite
 from .parse import load_scene, parse_scene, scene_from_dict
 from .spec import (ContactSpec, ExactSpec, FoundationSpec, Isotropic, LawSpec, MemorySpec,

@@ -6,7 +6,7 @@ import math
 import sys
 
 from ..laws import FRICTION_LAWS
-from .errors import SceneError
+from ..errors import SceneError
 from .keys import declared
 from .reader import Table, coordinates, show, within
 from .spec import ContactSpec, FoundationSpec, LawSpec

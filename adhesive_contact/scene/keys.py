@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from ..laws import BONDING_LAWS, FRICTION_LAWS, NORMAL_LAWS
 from ..linear_solvers import METHODS as LINEAR_METHODS
-from ..scheme.bonding import INTEGRATORS
+from ..bonding import INTEGRATORS
 from ..step_methods import METHODS as STEP_METHODS
 
 

@@ -1,7 +1,7 @@
 """The readers of ``[material]`` and ``[memory]``: isotropic tensors given
 by a Young or a Lamé pair, and the memory kernels built of them."""
 
-from .errors import SceneError
+from ..errors import SceneError
 from .keys import MAX_MODULUS, MIN_MODULUS
 from .reader import Table
 from .spec import Isotropic, MemorySpec, PronyTerm

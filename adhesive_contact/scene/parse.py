@@ -16,7 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .contact import read_contact
-from .errors import SceneError
+from ..errors import SceneError
 from .keys import MAX_TITLE, declared
 from .materials import (check_elastic, check_relaxation_step, instantaneous, read_material,
                         read_memory)

@@ -6,7 +6,7 @@ import difflib
 import math
 
 from ..expressions import ExpressionError, compile_expression
-from .errors import SceneError
+from ..errors import SceneError
 from .keys import declared, offered
 
 

@@ -12,7 +12,7 @@ from ..expressions import compile_expression
 from ..fem.meshes.builtin import SIDES, nodes_of
 from ..linear_solvers.pardiso import available as pardiso_available
 from ..verification.manufactured import symbolic_problem
-from .errors import SceneError
+from ..errors import SceneError
 from .keys import (MAX_CELL_ASPECT, MAX_HALVINGS, MAX_NODES, MAX_UNIT, MIN_STEP, OUTPUT_FIELDS,
                    declared, default, keys_in)
 from .reader import coordinates, expression, show, vector_of_expressions

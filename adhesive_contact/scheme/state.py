@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .bonding import FacetRate, advance, damage
+from ..bonding import FacetRate, advance, damage
 from .contact_energy import ContactEnergy
 from ..expressions import coordinates
 from ..step_methods import MAX_ITERATIONS, Kink, StepOptions, minimise
@@ -383,11 +383,11 @@ def initial_state(problem, unknowns=None):
 
 def bonding_step(problem, state, k):
     """(4.2): β_n from β_{n−1} and u_{n−1} over the step k = t_n − t_{n−1}
-    by the scene's integrator (:mod:`adhesive_contact.scheme.bonding`);
+    by the scene's integrator (:mod:`adhesive_contact.bonding`);
     explicit Euler, the paper's, is β_n = β_{n−1} + k P_B F(u_{n−1,ν},
     u_{n−1,τ}, β_{n−1}) (β frozen without a bonding law, and at n = 0); a
     rate-independent law's damage update
-    (:mod:`adhesive_contact.scheme.bonding.damage`) in its place.
+    (:mod:`adhesive_contact.bonding.damage`) in its place.
 
     The second-order scheme freezes the rate at the midpoint t_{n−½}: the
     displacement extrapolated there, u_{n−½} ≈ (3 u_{n−1} − u_{n−2})/2 on

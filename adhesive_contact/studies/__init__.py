@@ -5,10 +5,11 @@
 missing); :mod:`.pool` runs the runs in this process, in local worker
 processes or on any executor; :mod:`.executors` is the executor of a
 ``dask.distributed`` cluster; :mod:`.convergence` is the convergence study
-in h, k or both, :mod:`.sweep` a parameter sweep.
+in h, k or both (a level and the reference run by :mod:`.levels`),
+:mod:`.sweep` a parameter sweep.
 """
 
-from .convergence import ConvergenceResult, ConvergenceStudy
+from .convergence import ConvergenceResult, ConvergenceStudy, LevelRow
 from .executors import ClusterError, DaskExecutor, dask_executor
 from .pool import execute
 from .study import (
@@ -20,9 +21,9 @@ from .study import (
     StudyMismatch,
     study_document,
 )
-from .sweep import Sweep, SweepResult
+from .sweep import Sweep, SweepResult, SweepRow
 
-__all__ = ["ClusterError", "ConvergenceResult", "ConvergenceStudy", "DaskExecutor",
+__all__ = ["ClusterError", "ConvergenceResult", "ConvergenceStudy", "LevelRow", "DaskExecutor",
            "dask_executor", "execute", "RunFailed", "RunStore",
            "Study", "StudyError", "StudyFolderError", "StudyMismatch", "study_document",
-           "Sweep", "SweepResult"]
+           "Sweep", "SweepResult", "SweepRow"]

@@ -1,15 +1,15 @@
 """Convergence studies in h, k or both, kept in a folder (docs/verification.md).
 
-The computation of one level and of the fine reference is
-:mod:`adhesive_contact.verification.levels`; :class:`ConvergenceStudy` is the
-study on top of :class:`~adhesive_contact.studies.study.Study`. Its folder:
+The computation of one level and of the fine reference is :mod:`.levels`;
+:class:`ConvergenceStudy` is the study on top of
+:class:`~adhesive_contact.studies.study.Study`. Its folder:
 
 - ``study.json``: the resolved scene (level 0), param, levels, reference
   kind, ref_h and ref_k, and the sha256 of exactly that;
 - ``reference.npz`` (reference ``"fine"``): the reference run's t, u, beta,
   facets, its refine and steps and its wall time, saved once computed;
-- ``levels/level_NN.json``: one record of
-  :func:`~adhesive_contact.verification.levels.run_level` per finished level;
+- ``levels/level_NN.json``: one record of :func:`~.levels.run_level` per
+  finished level;
 - ``errors.csv`` and ``rates.json`` (:func:`results`): rewritten from the
   saved records at the end of every completed run.
 
@@ -46,7 +46,11 @@ from ..postprocess.scalars import (quantity_kind, quantity_names, quantity_unava
 from ..postprocess.units import unit_of
 from ..problem.build import build_problem
 from ..verification.rates import pairwise_rates, rates
-from ..verification.levels import (
+from ..fem.meshes import build_mesh
+from ..scene import SceneError, scene_from_dict
+from ..scene.materials import check_relaxation_step
+from ..storage import write_atomic, write_csv, write_json
+from .levels import (
     PARAMS,
     Reference,
     default_reference_refinement,
@@ -57,10 +61,6 @@ from ..verification.levels import (
     run_reference,
     with_discretisation,
 )
-from ..fem.meshes import build_mesh
-from ..scene import SceneError, scene_from_dict
-from ..scene.materials import check_relaxation_step
-from ..storage import write_atomic, write_csv, write_json
 from .pool import attempt, in_this_process
 from .study import RunFailed, Study, StudyError, scene_identity, scene_source
 
@@ -141,6 +141,73 @@ def load_reference(path, scene, arrays=True, quantity=None, kept=None):
 # ---------------------------------------------------------------- results
 
 
+#: a level's entries in rates.json, in their order (:meth:`LevelRow.as_dict`)
+LEVEL_KEYS = ("h", "k", "dofs", "err_u", "err_beta", "E", "seconds", *RELATIVE_KEYS, "level",
+              "steps", "refine", "rate_E", "newton_iterations")
+
+
+@dataclass(frozen=True)
+class LevelRow:
+    """One level of a convergence study: an entry of rates.json's
+    ``levels`` and a row of errors.csv.
+
+    Attributes
+    ----------
+    level, refine, steps : the level, its mesh refinement and its steps
+    h, k, dofs : its mesh size, step and degrees of freedom
+    err_u, err_beta, E : its errors (:func:`~.levels.run_level`)
+    rel_u, rel_beta, rel_E : the errors relative to the solution's norms
+        (None for a level saved without them, or a zero solution)
+    rate_E : the pairwise rate of E from the level before (None on the first)
+    seconds, newton_iterations : its wall time and Newton iterations
+    quantity, err_q, rel_q, rate_q : in a study of a quantity, Q_h, its
+        error, relative error (:func:`quantity_errors`) and pairwise rate;
+        else None
+    """
+
+    level: int
+    refine: int
+    steps: int
+    h: float
+    k: float
+    dofs: int
+    err_u: float
+    err_beta: float
+    E: float
+    rel_u: float
+    rel_beta: float
+    rel_E: float
+    rate_E: float
+    seconds: float
+    newton_iterations: object = None
+    quantity: float = None
+    err_q: float = None
+    rel_q: float = None
+    rate_q: float = None
+
+    @classmethod
+    def of(cls, record, rate_E, rate_q=None):
+        """The row of a level record (with :func:`quantity_errors`' entries
+        in a study of a quantity) and its pairwise rates."""
+        return cls(**{key: record[key] for key in ("level", "steps", "h", "k", "dofs", "err_u",
+                                                    "err_beta", "E", "seconds")},
+                   refine=record.get("refine"),
+                   **{key: _finite(record.get(key)) for key in RELATIVE_KEYS},
+                   rate_E=rate_E, newton_iterations=record.get("newton_iterations"),
+                   **{key: _finite(record.get(key)) for key in ("quantity", "err_q", "rel_q")},
+                   rate_q=rate_q)
+
+    def as_dict(self, quantity=False):
+        """The level as rates.json holds it (:data:`LEVEL_KEYS`, then
+        :data:`QUANTITY_COLUMNS` in a study of a ``quantity``)."""
+        keys = LEVEL_KEYS + (QUANTITY_COLUMNS if quantity else ())
+        return {key: getattr(self, key) for key in keys}
+
+    def to_row(self, columns):
+        """The cells of ``columns`` (of :func:`csv_columns`), in their order."""
+        return [getattr(self, column) for column in columns]
+
+
 def quantity_errors(records, name, reference_value):
     """The records with a study of quantity ``name``'s entries: ``quantity``
     Q_h (the level's value), ``err_q`` = |Q_h − Q_ref| and ``rel_q`` =
@@ -176,18 +243,8 @@ def results(records, param, reference_info, quantity=None):
     pairwise = pairwise_rates(records, param)
     pairwise_q = (pairwise_rates(records, param, key="err_q") if quantity is not None
                   else [None] * len(records))
-    levels = []
-    for record, rate, rate_q in zip(records, pairwise, pairwise_q):
-        row = ({key: record[key] for key in ("h", "k", "dofs", "err_u", "err_beta",
-                                              "E", "seconds")}
-               | {key: _finite(record.get(key)) for key in RELATIVE_KEYS}
-               | {"level": record["level"], "steps": record["steps"],
-                  "refine": record.get("refine"), "rate_E": rate,
-                  "newton_iterations": record.get("newton_iterations")})
-        if quantity is not None:
-            row |= {"quantity": _finite(record["quantity"]), "err_q": _finite(record["err_q"]),
-                    "rel_q": _finite(record["rel_q"]), "rate_q": rate_q}
-        levels.append(row)
+    levels = [LevelRow.of(record, rate, rate_q).as_dict(quantity is not None)
+              for record, rate, rate_q in zip(records, pairwise, pairwise_q)]
     document = {"param": param, "levels": levels,
                 "rates": rates(records, param, quantity=quantity is not None),
                 "reference": reference_info}
@@ -260,11 +317,13 @@ def csv_header(document):
 
 def write_errors_csv(path, document):
     """``errors.csv``: a header of :func:`csv_columns`, then one row per
-    level (:func:`adhesive_contact.storage.write_csv`: None — a rate_E on
+    level (its :class:`LevelRow`, of the :func:`results` document's entry,
+    written by :func:`adhesive_contact.storage.write_csv`: None — a rate_E on
     the first level, a relative error of a zero solution or of a level
     saved without it — an empty cell)."""
-    rows = [[level.get(c) for c in csv_columns(document)] for level in document["levels"]]
-    write_csv(path, csv_header(document), rows)
+    columns = csv_columns(document)
+    write_csv(path, csv_header(document),
+              [LevelRow(**level).to_row(columns) for level in document["levels"]])
 
 
 # ---------------------------------------------------------------- in a worker
@@ -347,7 +406,7 @@ class ConvergenceStudy(Study):
     ref_h, ref_k : int, optional
         The fine reference has ``ref_h`` more mesh refinements and
         ``2**ref_k`` times the steps of the finest level
-        (default :func:`~adhesive_contact.verification.levels.default_reference_refinement`);
+        (default :func:`~.levels.default_reference_refinement`);
         only with ``reference="fine"``.
     refine, steps : int, optional
         Mesh refinement and steps of level 0 instead of the scene's.

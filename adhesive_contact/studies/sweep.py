@@ -35,13 +35,16 @@ import math
 import itertools
 import resource
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from .. import SceneError, build_problem, scene_from_dict, solve
+from ..errors import SceneError
 from ..postprocess.scalars import quantity_kind, scalar_quantities, state_quantities
 from ..postprocess.units import with_unit
+from ..problem import build_problem
 from ..problem.warnings import solution_warnings
+from ..scene import scene_from_dict
+from ..scheme import solve
 from ..storage import plain, toml_value, write_csv
 from .study import Study, StudyError, scene_identity, scene_source
 
@@ -57,6 +60,8 @@ MEASURED = ("outcome", "failed_step", "failed_t", "residual", "seconds", "newton
             "newton_max", "worker_peak_rss_mib", "beta_min_T", "beta_mean_T",
             "max_un_minus_g", "separated_T", "on_wall_T", "compliance_T", "stick_T",
             "slip_T", "normal_force_T")
+#: the columns of MEASURED a failure fills in
+_FAILURE_COLUMNS = ("outcome", "failed_step", "failed_t")
 
 
 # ---------------------------------------------------------------- settings
@@ -252,30 +257,79 @@ def csv_columns(keys, quantities=()):
     return ["run", *keys, *MEASURED, *quantities]
 
 
-def run_row(record, keys, quantities=()):
-    """One runs.csv row (a dict by column) of a run record."""
-    failure = record.get("failure") or {}
-    row = {"run": record["run"], **{key: record["values"][key] for key in keys}}
-    for column in MEASURED:
-        row[column] = record.get(column)
-    given = record.get("quantities") or {}
-    for column in quantities:
-        row[column] = given.get(column)
-    row.update(failed_step=failure.get("step"), failed_t=failure.get("t"))
-    row["message"] = failure.get("message")   # printed, not a column of runs.csv
-    return row
+@dataclass(frozen=True)
+class SweepRow:
+    """One run of a sweep as ``runs.csv`` shows it.
+
+    Attributes
+    ----------
+    run : int, the run's number
+    values : dict, {swept key: value}
+    outcome : "ok", "failed" or :data:`LOST`
+    failed_step, failed_t : the step and time a failed run stopped at (None
+        for a run that did not fail, or a combination that is not a scene)
+    measured : dict, the other :data:`MEASURED` columns, None where the
+        run has no value
+    quantities : dict, {scalar quantity column: value}, None where the run
+        has none
+    message : why the run failed or was lost (printed, not a column), or None
+
+    ``row[column]`` (and ``row.get(column)``) is the cell of a column of
+    :func:`csv_columns`, or the message: a row reads like the table.
+    """
+
+    run: int
+    values: dict
+    outcome: str
+    failed_step: object = None
+    failed_t: object = None
+    measured: dict = field(default_factory=dict)
+    quantities: dict = field(default_factory=dict)
+    message: str = None
+
+    @classmethod
+    def of(cls, record, keys, quantities=()):
+        """The row of a run's record (:func:`run_variant` with its ``run``,
+        or :func:`lost_record`) for the swept ``keys`` and the
+        ``quantities`` columns (:func:`quantity_columns`)."""
+        failure = record.get("failure") or {}
+        given = record.get("quantities") or {}
+        return cls(run=record["run"], values={key: record["values"][key] for key in keys},
+                   outcome=record.get("outcome"), failed_step=failure.get("step"),
+                   failed_t=failure.get("t"),
+                   measured={c: record.get(c) for c in MEASURED if c not in _FAILURE_COLUMNS},
+                   quantities={c: given.get(c) for c in quantities},
+                   message=failure.get("message"))
+
+    def cells(self):
+        """{column: value} of the row, and its ``"message"``."""
+        return {"run": self.run, **self.values, "outcome": self.outcome,
+                "failed_step": self.failed_step, "failed_t": self.failed_t, **self.measured,
+                **self.quantities, "message": self.message}
+
+    def __getitem__(self, column):
+        return self.cells()[column]
+
+    def get(self, column, default=None):
+        return self.cells().get(column, default)
+
+    def to_row(self, columns):
+        """The cells of ``columns``, in their order (None where the row has none)."""
+        cells = self.cells()
+        return [cells.get(column) for column in columns]
 
 
 def write_runs_csv(path, rows, keys, quantities=(), units=None, dim=2):
     """``runs.csv``: a header of :func:`csv_columns`, the measured
     quantities with their units where the base scene names them
     (``units``: ``[output.units]``, ``dim`` its dimension), one row per run
-    (:func:`adhesive_contact.storage.write_csv`; None an empty cell)."""
+    (``rows``: :class:`SweepRow`, written by
+    :func:`adhesive_contact.storage.write_csv`; None an empty cell)."""
     columns = csv_columns(keys, quantities)
     measured = set(MEASURED) | set(quantities)
     header = [with_unit(c, quantity_kind(c), units, dim) if c in measured and quantity_kind(c)
               else c for c in columns]
-    write_csv(path, header, [[row.get(c) for c in columns] for row in rows])
+    write_csv(path, header, [row.to_row(columns) for row in rows])
 
 
 # ---------------------------------------------------------------- the study
@@ -291,9 +345,9 @@ def lost_record(key, values, message):
 @dataclass
 class SweepResult:
     """What :meth:`Sweep.run` found: ``records`` (one per run, in run order),
-    ``rows`` (the runs.csv rows), ``computed`` (runs computed now, lost ones
-    excluded), ``files`` (names written) and ``lost`` (runs whose worker
-    died: rows, not saved)."""
+    ``rows`` (the runs.csv rows, a :class:`SweepRow` per run), ``computed``
+    (runs computed now, lost ones excluded), ``files`` (names written) and
+    ``lost`` (runs whose worker died: rows, not saved)."""
 
     records: list
     rows: list
@@ -454,7 +508,7 @@ class Sweep(Study):
             label=lambda key: f"run {key}", on_lost=on_lost)
         records = [done[key] if key in done else lost[key] for key in self.keys()]
         quantities = quantity_columns(records)
-        rows = [run_row(record, self.keys_set, quantities) for record in records]
+        rows = [SweepRow.of(record, self.keys_set, quantities) for record in records]
         write_runs_csv(self.folder / "runs.csv", rows, self.keys_set, quantities,
                        self.base.units, self.base.dim)
         return SweepResult(records, rows, [key for key in computed if key not in lost],

@@ -29,8 +29,7 @@ import numpy as np
 from ..fem.contact_boundary import facet_normals, facet_points, tangent_frame
 from ..expressions import coordinates
 from .manufactured import TOLERANCE, on_wall
-from ..scene.errors import where
-from ..scene import SceneError
+from ..errors import SceneError, where
 
 
 #: relative tolerance of the checks, and of the contact and stick sets

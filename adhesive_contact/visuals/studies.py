@@ -304,7 +304,7 @@ def figure_by_key(rows, keys, key, title, units=None, dim=2):
 
     Parameters
     ----------
-    rows : list of dict
+    rows : list of rows read by column (a sweep's ``SweepRow``, or dicts)
         The sweep's rows (``runs.csv``: the values set, ``outcome``,
         ``seconds``, ``newton_total``, ``beta_mean_T``, ``normal_force_T``).
     keys : list of str

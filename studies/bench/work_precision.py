@@ -8,7 +8,7 @@ The scene is the manufactured case (b) of ``studies/convergence/``
 positive multiplier on half of Γ_C, an adhesive spring, Frémond bonding),
 whose friction law is smooth, so both contact quadratures apply. Each
 point is one run, a (choice, h, k) with T = 1, measured by
-:func:`adhesive_contact.verification.levels.run_level` against the scene's
+:func:`adhesive_contact.studies.levels.run_level` against the scene's
 ``[exact]`` solution:
 
     E = max_n (‖ε(u(t_n) − u_n^hk)‖_{L²(Ω)} + ‖β(t_n) − β_n^hk‖_{L²(Γ_C)})
@@ -59,7 +59,7 @@ GRID_STEPS = (4, 8, 16, 32, 64, 128)
 def variant(base, *, linear="superlu", quadrature="nodal", refine=0, steps=4, amg_tol=None):
     """The base scene with a backend (and AMG's tolerance), a quadrature, a
     refinement and steps."""
-    from adhesive_contact.verification.levels import with_discretisation
+    from adhesive_contact.studies.levels import with_discretisation
 
     solver = replace(base.solver, linear=linear)
     if amg_tol is not None:
@@ -72,7 +72,7 @@ def variant(base, *, linear="superlu", quadrature="nodal", refine=0, steps=4, am
 def measure(scene):
     """One run (level 0 of an h-study of ``scene``): its record, timed by
     the fastest of 3 when it takes under REPEAT_BELOW seconds, else of 2."""
-    from adhesive_contact.verification.levels import run_level
+    from adhesive_contact.studies.levels import run_level
 
     try:
         record = run_level(scene, "h", 0)

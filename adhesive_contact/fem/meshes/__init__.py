@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...scene.errors import SceneError
+from ...errors import SceneError
 from .builtin import side_tests, structured_mesh
 from .facets import facet_index, refined_with_boundaries, refinement_parents
 from .gmsh_file import MeshFileError, read_mesh_file

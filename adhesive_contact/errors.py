@@ -1,9 +1,11 @@
 """The error of a scene that cannot be run, and how a message names a point.
 
-This module imports nothing of the package, so that the layers the scene
-reader itself uses (the meshes) can raise :class:`SceneError` without a
-cycle; :func:`where` is the one way every check (before a run, of a
-manufactured solution, of a level) writes the point it found.
+At the base of the package (it imports nothing of it): the meshes, the
+check of a manufactured solution, the scene reader, the problem's checks
+and the scheme's check of a level all raise :class:`SceneError`, which
+``adhesive_contact`` and ``adhesive_contact.scene`` hand on;
+:func:`where` is the one way every check (before a run, of a manufactured
+solution, of a level) writes the point it found.
 """
 
 import numpy as np
@@ -30,7 +32,11 @@ class SceneError(ValueError):
 
     def __init__(self, key, message):
         self.key = key
+        self.reason = message
         super().__init__(f"{shown_key(key)}: {message}" if key else message)
+
+    def __reduce__(self):   # survive the trip back from a worker process
+        return type(self), (self.key, self.reason)
 
 
 def where(points, index=None, t=None, digits=6):

@@ -1,9 +1,9 @@
-"""Convergence studies in h, k or both (docs/verification.md).
+"""The levels of a convergence study in h, k or both (docs/verification.md).
 
 A study refines a scene level by level — ``"h"``: one uniform (nested)
 mesh refinement per level; ``"k"``: the step halved per level; ``"hk"``:
 both — and measures at each level the errors of
-:mod:`.errors`, max over the level's time grid,
+:mod:`adhesive_contact.verification.errors`, max over the level's time grid,
 against
 
 - the scene's exact solution (``reference = "exact"``), or
@@ -12,8 +12,10 @@ against
   defaults refine only in what the study varies, so that the other error,
   common to all levels and the reference, cancels.
 
-Their rates are :mod:`.rates`. Everything here is pure computation: the caller stores the level records
-(and the reference) and decides what to recompute.
+Their rates are :mod:`adhesive_contact.verification.rates`. Each level
+and the reference is a run (the scene built and solved); nothing here is
+stored: the study (:mod:`.convergence`) keeps the level records and the
+reference and decides what to recompute.
 """
 
 import time
@@ -26,7 +28,7 @@ from ..fem.contact_boundary import facet_normals
 from ..fem.meshes import mesh_size
 from ..problem.build import build_problem
 from ..scheme import solve
-from .errors import (
+from ..verification.errors import (
     ExactErrors,
     facet_parents,
     nested_meshes,
