@@ -343,3 +343,56 @@ def test_a_scheme_the_command_cannot_reach_is_one_line_exit_2(scenes, tmp_path, 
     assert_one_line_error(result, 2, f"--scheduler {address}: the scheme "
                           f"{address.split(':')[0]}:// cannot reach a scheduler from this "
                           "command")
+
+
+# ---------------------------------------------------------------- without distributed
+
+#: a process in which ``distributed`` and ``dask`` cannot be imported, as in
+#: the default install (``pip install .``, without the extra "dask"), that
+#: runs the command line with the arguments of sys.argv[1:]
+WITHOUT_DISTRIBUTED = """
+import sys
+for name in ("distributed", "dask"):
+    sys.modules[name] = None          # import distributed: ModuleNotFoundError
+from adhesive_contact_cli.main import main
+main(sys.argv[1:], prog_name="adhcontact")
+"""
+
+
+@pytest.mark.parametrize("command, args", [("sweep", GRID),
+                                           ("converge", ("--param", "k", "--levels", 2))])
+def test_scheduler_without_distributed_names_the_extra_exit_2(scenes, tmp_path, command, args):
+    import subprocess
+    import sys
+    done = subprocess.run([sys.executable, "-c", WITHOUT_DISTRIBUTED, command,
+                           str(scenes.block), *map(str, args), "--scheduler",
+                           "tcp://127.0.0.1:9", "--out", str(tmp_path / command)],
+                          capture_output=True, text=True, timeout=120)
+    result = SimpleNamespace(exit_code=done.returncode, stdout=done.stdout, stderr=done.stderr)
+    assert_one_line_error(result, 2, "--scheduler tcp://127.0.0.1:9: needs the package "
+                          'distributed, which the default install leaves out: install the '
+                          'extra "dask", pip install ".[dask]" from the repository')
+    assert not (tmp_path / command).exists()
+
+
+def test_dask_executor_without_distributed_raises_one_line_naming_the_extra():
+    import subprocess
+    import sys
+    code = ("import sys\n"
+            "sys.modules['distributed'] = None\n"
+            "from adhesive_contact.studies import ClusterError, dask_executor\n"
+            "try:\n"
+            "    dask_executor('tcp://127.0.0.1:9')\n"
+            "except ClusterError as err:\n"
+            "    print(err.message)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, check=True)
+    assert done.stdout == executors.NOT_INSTALLED + "\n"
+    assert '".[dask]"' in done.stdout and "\n" not in done.stdout.strip()
+    # the extra holds distributed, and the default install does not
+    import tomllib
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml")
+                            .read_text())["project"]
+    assert not [d for d in project["dependencies"] if d.startswith("distributed")]
+    assert project["optional-dependencies"]["dask"] == ["distributed>=2024.1"]
+    assert "distributed>=2024.1" in project["optional-dependencies"]["test"]

@@ -6,7 +6,9 @@ wrong: a step beyond the explicit Euler bound of the bonding law, a step
 beyond an accuracy guide of :mod:`.accuracy` (the bonding law's time scale
 with another integrator, the memory's quadrature error), a
 contact stiffness many orders of magnitude away from the body's (the step
-matrix is then ill-conditioned, or the contact law irrelevant), and the
+matrix is then ill-conditioned, or the contact law irrelevant), a curved
+foundation pressed where a symmetry side cuts the built-in "diagonal"
+pattern (the pressure at the node there reads several per cent off), and the
 material data the discretisation or physics cannot bear (:mod:`.plausibility`:
 ν near ½ with P1 elements, a modulus no solid has in the named units);
 ``adhcontact solve``, ``check`` and ``sweep`` show them. The theory's
@@ -22,6 +24,8 @@ linear, small-strain model represents.
 
 import numpy as np
 
+from ..fem.foundation import signed_distance
+from ..fem.meshes.builtin import SIDES
 from ..laws.bonding import BEYOND_TIME_SCALE
 from .accuracy import (MEMORY_GUIDE, bonding_time_scale, memory_error, shortest_relaxation_time,
                        steps_for_memory, steps_for_time_scale)
@@ -403,6 +407,91 @@ def stiffness_warning(problem):
                if ratio > 1 else "(the foundation barely holds the body)"))
 
 
+#: the closest nodes of Γ_C to a foundation: within this fraction of the
+#: body's size of the closest (a cylinder's closest points are a line)
+CLOSEST = 1e-9
+#: what studies/validation/symmetry_side.py measured at the node on a symmetry
+#: side under a rigid cylinder or sphere against Hertz's pressure at the
+#: computed force, and the advice, by dimension
+SYMMETRY_SIDE_FIGURES = {
+    2: ("reads 3.5–9 % off Hertz's pressure at 5–12 elements across the contact "
+        "half-width (1.9–2.8 % at 23), where its neighbours read within 2.1 %",
+        'use mesh.pattern = "cross", whose cells are mirror-symmetric about every grid '
+        "line (that node then reads like the others, within about 2 %), or model the "
+        "whole body"),
+    3: ("reads 8.7–13.5 % above Hertz's pressure at 3.5–6 elements across the contact "
+        "half-width, where the nodes beside the side read within 3 %",
+        "model the whole body (the box has no pattern symmetric about its sides)"),
+}
+
+
+def symmetry_sides(scene):
+    """The sides of the built-in mesh held along their normal only (rollers:
+    the normal component prescribed, every tangential one free), the sides
+    a half or quarter model mirrors the body at."""
+    names = SIDES[scene.dim]
+    out = []
+    for side, components in scene.displacement.items():
+        if side not in names:
+            continue
+        axis = names.index(side) // 2
+        held = [c is not None for c in components]
+        if held[axis] and sum(held) == 1:
+            out.append(side)
+    return out
+
+
+def along_axis(foundation, side, dim):
+    """Whether the normal of a side of the built-in mesh lies along the axis
+    of a cylinder foundation: the pressure does not vary across that side
+    (a plane-strain section's ends), so its mirror changes nothing there
+    (the box's nodes on it read within 1 % of those mid-length)."""
+    if foundation.shape != "cylinder":
+        return False
+    axis = np.asarray(foundation.axis, dtype=float)
+    return abs(axis[SIDES[dim].index(side) // 2]) > (1.0 - 1e-9) * np.linalg.norm(axis)
+
+
+def symmetry_side_warning(problem):
+    """A line when a sphere or cylinder foundation's closest point on Γ_C
+    lies on a symmetry side of the built-in "diagonal" pattern (rectangle
+    or box).
+
+    A side held along its normal only mirrors the body there: the run is
+    the whole body on the mesh and its mirror image, whose cells meet at
+    the side in a chevron (the diagonals of the two halves point apart or
+    together) where the pattern's own cells continue unchanged. The node
+    at the foundation's closest point (Hertz's peak) is then unlike its
+    neighbours, and its nodal pressure −F_{a,ν}/w_a reads several per cent
+    off Hertz's while theirs do not (:data:`SYMMETRY_SIDE_FIGURES`). The
+    "cross" cells are mirror-symmetric about every grid line, so its half
+    model is its whole body; a file mesh is left to its maker. A side
+    across a cylinder's axis is no such side (:func:`along_axis`)."""
+    scene = problem.scene
+    contact = scene.contact
+    if (scene.mesh.domain == "file" or scene.mesh.pattern != "diagonal"
+            or problem.boundary is None or contact is None or contact.foundation is None
+            or contact.foundation.shape == "plane"):
+        return None
+    sides = symmetry_sides(scene)
+    if not sides:
+        return None
+    mesh, nodes = problem.mesh, problem.boundary.nodes
+    distance = signed_distance(contact.foundation, mesh.p[:, nodes])
+    closest = nodes[distance <= distance.min() + CLOSEST * body_size(problem)]
+    on = [side for side in sides if not along_axis(contact.foundation, side, scene.dim)
+          and np.isin(closest, mesh.facets[:, mesh.boundaries[side]]).any()]
+    if not on:
+        return None
+    error, advice = SYMMETRY_SIDE_FIGURES[scene.dim]
+    named = ", ".join(repr(side) for side in on)
+    return (f"the {contact.foundation.shape} foundation's closest point on Γ_C is on the "
+            f"symmetry side{'s' if len(on) > 1 else ''} {named} (held along the normal "
+            f"only), about which the \"diagonal\" pattern's cells are not mirror-symmetric: "
+            f"the contact pressure at the node there {error}; {advice} "
+            "(docs/conventions.md#a-symmetry-side-of-the-diagonal-pattern)")
+
+
 #: the warnings on the uniform step k = T/N; a scene with ``[time.adaptive]``
 #: gets none of them: its steps are chosen by its tol and kept below the
 #: explicit Euler bound, k = T/N is only the largest
@@ -414,7 +503,7 @@ def problem_warnings(problem):
     steps = STEP_WARNINGS if problem.scene.adaptive is None else ()
     return [w for w in (held_by_contact_warning(problem),
                         *(warning(problem) for warning in steps),
-                        stiffness_warning(problem))
+                        stiffness_warning(problem), symmetry_side_warning(problem))
             if w is not None] + plausibility_warnings(problem.scene)
 
 

@@ -21,7 +21,9 @@ that kills its worker every time comes back as lost
 had no worker for ``patience`` seconds, or the scheduler is gone,
 :class:`ClusterError` is raised.
 
-``distributed`` is imported only when a study is sent to a cluster.
+``distributed`` is imported only when a study is sent to a cluster; it is
+not in the package's default install but in its extra ``dask``
+(``pip install ".[dask]"``), which :data:`NOT_INSTALLED` names.
 
 From Python::
 
@@ -47,6 +49,10 @@ HOST_PORT_SCHEMES = ("tcp", "tls", "ws", "wss")
 HANDSHAKE_BYTES = 1 << 20
 #: seconds between two looks for finished runs
 WAKE = 0.02
+#: what a study sent to a cluster says where ``distributed`` is not installed
+NOT_INSTALLED = ('needs the package distributed, which the default install leaves out: '
+                 'install the extra "dask", pip install ".[dask]" from the repository (or '
+                 'pip install "distributed>=2024.1")')
 
 
 def _plugin_name(token):
@@ -166,7 +172,8 @@ def dask_executor(scheduler, *, timeout=None, patience=60.0):
     Raises
     ------
     ClusterError
-        ``distributed`` is not installed, the address is malformed, or no
+        ``distributed`` is not installed (:data:`NOT_INSTALLED`: the extra
+        ``dask``), the address is malformed, or no
         scheduler answered there within ``timeout`` seconds.
     """
     if not isinstance(scheduler, str):
@@ -175,8 +182,7 @@ def dask_executor(scheduler, *, timeout=None, patience=60.0):
     try:
         import distributed
     except ImportError:
-        raise ClusterError(scheduler, "needs the package distributed "
-                           "(pip install distributed)") from None
+        raise ClusterError(scheduler, NOT_INSTALLED) from None
     try:
         scheme, location = distributed.comm.parse_address(scheduler)
         distributed.comm.registry.get_backend(scheme)
