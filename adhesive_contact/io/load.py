@@ -9,6 +9,7 @@ gives the problem); ``solution.npz`` gives every array
 :class:`~.streaming.StreamingRecorder` the command line solves with.
 """
 
+import contextlib
 import json
 import zipfile
 from pathlib import Path
@@ -51,7 +52,7 @@ def read_arrays(path, names, expected=None):
     ``expected``: {name: (shape, kind)} checked against each array's header
     before it is read (:data:`KINDS`); an array of another shape or kind
     is an :class:`OutputFolderError` naming it, and nothing is allocated."""
-    try:
+    with npz_errors(path):
         headers = array_headers(path, names)
         missing = [name for name in names if name not in headers]
         if missing:
@@ -69,6 +70,14 @@ def read_arrays(path, names, expected=None):
                                         "is damaged; run the scene again")
         with np.load(path, allow_pickle=False) as data:
             return {name: data[name] for name in names}
+
+
+@contextlib.contextmanager
+def npz_errors(path):
+    """A block reading the npz file ``path``: a missing or unreadable file
+    is an :class:`OutputFolderError` naming it."""
+    try:
+        yield
     except FileNotFoundError:
         raise OutputFolderError(path, "no such file; an output folder of 'adhcontact solve' "
                                 "has one (docs/outputs.md)") from None
@@ -203,7 +212,8 @@ def _fields_and_scalars(path, levels):
     """(field levels, scalars) of solution.npz at ``path`` for a run of
     ``levels`` levels: the levels whose u it holds (None: every level) and
     {name: (kind, values)} of its scalars (None when not recorded)."""
-    headers = array_headers_or_error(path, OPTIONAL)
+    with npz_errors(path):
+        headers = array_headers(path, OPTIONAL)
     if "u_levels" not in headers:
         return None, None
     count = headers["u_levels"][0]
@@ -227,15 +237,3 @@ def _fields_and_scalars(path, levels):
         scalars = {str(name): (str(kind), values[:, i]) for i, (name, kind) in
                    enumerate(zip(arrays["scalar_names"], arrays["scalar_kinds"]))}
     return field_levels, scalars
-
-
-def array_headers_or_error(path, names):
-    """:func:`array_headers`, a file that cannot be read an OutputFolderError."""
-    try:
-        return array_headers(path, names)
-    except FileNotFoundError:
-        raise OutputFolderError(path, "no such file; an output folder of 'adhcontact solve' "
-                                "has one (docs/outputs.md)") from None
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
-        raise OutputFolderError(path, f"cannot be read ({type(err).__name__}: {err}): the "
-                                "file is damaged; run the scene again") from None
